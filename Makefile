@@ -1,0 +1,78 @@
+# bksim: `make` builds libbksim.a and ./bksim; `make test` runs the cmocka suite twice,
+# plain and under AddressSanitizer + UndefinedBehaviorSanitizer.
+
+CC       ?= gcc
+PKGS     := hdf5-serial gsl inih
+SUNDIALS := -lsundials_cvode -lsundials_ida -lsundials_arkode -lsundials_nvecserial \
+            -lsundials_sunmatrixdense -lsundials_sunmatrixband \
+            -lsundials_sunlinsoldense -lsundials_sunlinsolband \
+            -lsundials_sunnonlinsolnewton -lsundials_sunnonlinsolfixedpoint
+
+WARN     := -Wall -Wextra -Werror -Wshadow -Wconversion -Wstrict-prototypes \
+            -Wmissing-prototypes -Wformat=2
+CPPFLAGS := -Iinclude -Isrc -D_POSIX_C_SOURCE=200809L $(shell pkg-config --cflags $(PKGS))
+CFLAGS   ?= -O2 -g
+CFLAGS   += -std=c11 $(WARN)
+LDLIBS   := $(shell pkg-config --libs $(PKGS)) $(SUNDIALS) -lm
+TEST_LIBS := $(shell pkg-config --libs cmocka)
+SAN      := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+
+LIB_SRC  := $(wildcard src/*.c src/friction/*.c src/solver/*.c src/output/*.c)
+CLI_SRC  := $(wildcard src/cli/*.c)
+TEST_SRC := $(wildcard tests/test_*.c)
+TEST_SUPPORT := $(filter-out $(TEST_SRC),$(wildcard tests/*.c))
+
+# $(call objs,BUILD_DIR,SOURCES)
+objs = $(patsubst %.c,$(1)/%.o,$(2))
+
+.SECONDARY:
+.PHONY: all test test-plain test-asan clean paper bench install
+all: bksim
+
+build/libbksim.a: $(call objs,build,$(LIB_SRC))
+	$(AR) rcs $@ $^
+build-asan/libbksim.a: $(call objs,build-asan,$(LIB_SRC))
+	$(AR) rcs $@ $^
+
+bksim: $(call objs,build,$(CLI_SRC)) build/libbksim.a
+	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
+
+build/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -c -o $@ $<
+build-asan/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(SAN) -O1 -MMD -MP -c -o $@ $<
+
+TESTS      := $(patsubst tests/%.c,build/tests/%,$(TEST_SRC))
+TESTS_ASAN := $(patsubst tests/%.c,build-asan/tests/%,$(TEST_SRC))
+
+build/tests/test_%: build/tests/test_%.o $(call objs,build,$(TEST_SUPPORT)) build/libbksim.a
+	$(CC) $(CFLAGS) -o $@ $^ $(TEST_LIBS) $(LDLIBS)
+build-asan/tests/test_%: build-asan/tests/test_%.o $(call objs,build-asan,$(TEST_SUPPORT)) build-asan/libbksim.a
+	$(CC) $(CFLAGS) $(SAN) -o $@ $^ $(TEST_LIBS) $(LDLIBS)
+
+# Tests run from the repository root (they read configs/ and need ./bksim for CLI tests).
+test: test-plain test-asan
+test-plain: bksim $(TESTS)
+	@scripts/run_tests.sh build/tests $(TESTS)
+test-asan: bksim $(TESTS_ASAN)
+	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+	 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
+	 scripts/run_tests.sh build-asan/tests $(TESTS_ASAN)
+
+paper: bksim
+	scripts/run_paper.sh
+
+clean:
+	rm -rf build build-asan bksim
+
+PREFIX ?= /usr/local
+install: bksim build/libbksim.a
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include/bksim
+	install -m 755 bksim $(DESTDIR)$(PREFIX)/bin/
+	install -m 644 build/libbksim.a $(DESTDIR)$(PREFIX)/lib/
+	install -m 644 include/bksim/*.h $(DESTDIR)$(PREFIX)/include/bksim/
+
+-include $(shell find build build-asan -name '*.d' 2>/dev/null)

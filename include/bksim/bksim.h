@@ -1,0 +1,18 @@
+/* bksim: Burridge-Knopoff spring-block chains with stick-slip friction.  Umbrella header. */
+#ifndef BKSIM_BKSIM_H
+#define BKSIM_BKSIM_H
+
+#define BKSIM_VERSION "0.1.0"
+
+#include "bksim/config.h"
+#include "bksim/driver.h"
+#include "bksim/friction.h"
+#include "bksim/model.h"
+#include "bksim/modes.h"
+#include "bksim/output.h"
+#include "bksim/param.h"
+#include "bksim/run.h"
+#include "bksim/solver.h"
+#include "bksim/status.h"
+
+#endif

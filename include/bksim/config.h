@@ -1,0 +1,72 @@
+/* A run described by one INI file (plus --set overrides): parsed with inih, every key
+ * checked against one table of keys, every failure reported as
+ *   file:line: [section] key: message (allowed range)
+ * before anything is written.  See README "Config reference" (generated from the table
+ * by `bksim keys`). */
+#ifndef BKSIM_CONFIG_H
+#define BKSIM_CONFIG_H
+
+#include <stdio.h>
+
+#include "bksim/model.h"
+#include "bksim/status.h"
+
+/* Output fields beyond /time and /driver, which are always written. */
+enum {
+    BK_FIELD_X = 1u << 0,        /* /x  block positions, m */
+    BK_FIELD_V = 1u << 1,        /* /v  block velocities, m/s */
+    BK_FIELD_FRICTION = 1u << 2, /* /friction interface shear force, N */
+    BK_FIELD_COF = 1u << 3,      /* /cof apparent coefficient of friction */
+    BK_FIELD_MODE = 1u << 4,     /* /mode stick 0, slip+ 1, slip- -1 */
+    BK_FIELD_ENERGY = 1u << 5,   /* /energy_* and /work_driver, /dissipation, J */
+    BK_FIELD_STATE = 1u << 6,    /* /friction_state, per law */
+    BK_FIELD_ALL = (1u << 7) - 1
+};
+
+typedef struct bk_solver_options {
+    char method[32];        /* back-end name, e.g. "cvode_adams"; default "cvode_adams" */
+    char linear_solver[16]; /* "dense" | "band" | "auto" (implicit methods); default "auto" */
+    double rtol;            /* relative tolerance; default 1e-8 */
+    double atol_x;          /* m; NaN = auto (rtol * 1e-3 * slip length scale) */
+    double atol_v;          /* m/s; NaN = auto (rtol * 1e-3 * velocity scale) */
+    double max_step;        /* s; NaN = auto (1/8 of the fastest natural period) */
+    long max_steps;         /* solver steps allowed between two output rows; default 100000 */
+    int detect_velocity_extrema; /* locate slip-rate minima to catch hidden stops; default 1 */
+    long max_transitions_per_instant; /* per block, before a chattering error; default 100 */
+    double instant_window;  /* s: transitions closer than this count as one instant;
+                               NaN = auto (1e-6 of the fastest natural period) */
+} bk_solver_options;
+
+typedef struct bk_output_options {
+    char *path;        /* HDF5 output path, owned; default "<config stem>.h5" */
+    double interval;   /* s between samples; 0 = transition rows only; default t_end/1000 */
+    unsigned fields;   /* BK_FIELD_* mask; default all */
+    int transitions;   /* write /transitions; default 1 */
+    int event_rows;    /* add a row at every transition instant; default 1 */
+} bk_output_options;
+
+typedef struct bk_config {
+    bk_model *model;          /* owned */
+    bk_solver_options solver;
+    bk_output_options output;
+    double t_end;             /* s, > 0 */
+    char *source_name;        /* config file path (or the name given to load_string), owned */
+    char *text;               /* config text with the --set overrides appended, owned */
+} bk_config;
+
+/* Load and validate a config file.  overrides are "section.key=value" strings applied after
+ * the file (section may be "block.3").  On success *out owns a config (free with
+ * bk_config_free).  On failure returns BK_ERR_CONFIG (or BK_ERR_IO / BK_ERR_NOMEM), *out is
+ * NULL and err->message reads "file:line: [section] key: message (allowed range)". */
+int bk_config_load_file(const char *path, const char *const *overrides, size_t n_overrides,
+                        bk_config **out, bk_error *err);
+/* Same from text in memory; `name` stands in for the file name in messages. */
+int bk_config_load_string(const char *text, const char *name, const char *const *overrides,
+                          size_t n_overrides, bk_config **out, bk_error *err);
+void bk_config_free(bk_config *config);
+
+/* Write the key reference (every section and key: meaning, unit, default, range) as
+ * Markdown tables. */
+void bk_config_write_reference(FILE *out);
+
+#endif

@@ -1,0 +1,80 @@
+/* The run loop: one loop for every solver back-end.  Advance to the next output time or
+ * root, let the mode machine decide transitions, re-initialise, emit, repeat.  Results go
+ * to a sink (the HDF5 writer, or a test's memory sink). */
+#ifndef BKSIM_RUN_H
+#define BKSIM_RUN_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "bksim/config.h"
+#include "bksim/status.h"
+
+/* One row of the time series: the state of every block at time t.  Arrays have n_blocks
+ * entries and are valid only during the sink call. */
+typedef struct bk_sample {
+    double t;                 /* s */
+    double driver;            /* driver position, m */
+    size_t n_blocks;
+    const double *x;          /* m */
+    const double *v;          /* m/s */
+    const double *friction;   /* interface shear force, N; positive when it resists +x motion
+                                 (the force on the block is -friction) */
+    const double *cof;        /* friction / normal force */
+    const int8_t *mode;       /* bk_mode values */
+    const double *friction_state; /* model->n_friction_state entries (may be NULL if 0) */
+    double kinetic_energy;    /* J */
+    double elastic_energy;    /* J */
+    double work_driver;       /* J, work done by the driver since t = 0 */
+    double dissipation;       /* J, frictional dissipation since t = 0 */
+    int is_event;             /* 1 when this row is a transition instant (post-transition state) */
+} bk_sample;
+
+/* One block changing mode. */
+typedef struct bk_transition {
+    double t;      /* s */
+    int32_t block; /* 0-based */
+    int8_t from;   /* bk_mode */
+    int8_t to;     /* bk_mode */
+    double x;      /* m, position at the transition */
+    double v;      /* m/s, velocity after it (0 when it sticks or starts from rest) */
+    double force;  /* N, applied (spring) force on the block at the transition */
+} bk_transition;
+
+typedef struct bk_sink {
+    void *self;
+    int (*sample)(void *self, const bk_sample *sample, bk_error *err);
+    int (*transition)(void *self, const bk_transition *transition, bk_error *err);
+} bk_sink;
+
+typedef struct bk_run_stats {
+    char method[32];          /* back-end actually used */
+    long steps;               /* integrator steps */
+    long rhs_evals;
+    long root_evals;          /* root-function evaluations */
+    long err_test_fails;
+    long nonlin_iters;
+    long integrator_starts;   /* (re-)initialisations */
+    long stuck_jumps;         /* all-stuck intervals crossed in closed form */
+    long transitions;
+    long rows;                /* time-series rows emitted */
+    double t_reached;         /* s */
+    double wall_time;         /* s */
+    double cpu_time;          /* s */
+    double work_driver;       /* J */
+    double dissipation;       /* J */
+    double elastic_change;    /* J, elastic energy at t_reached minus at 0 */
+    double kinetic_change;    /* J */
+    double energy_residual;   /* (W - dE_el - dE_kin - D) / max(|W|, tiny), dimensionless */
+} bk_run_stats;
+
+/* Called now and then with the time reached; return non-zero to stop the run. */
+typedef int (*bk_progress_fn)(void *user, double t, double t_end);
+
+/* Run the configured scene from t = 0 to config->t_end, sending rows and transitions to
+ * sink.  stats may be NULL.  Returns BK_OK, or a negative code with err filled (the sink
+ * has then received a prefix of the run). */
+int bk_run(const bk_config *config, const bk_sink *sink, bk_run_stats *stats,
+           bk_progress_fn progress, void *progress_user, bk_error *err);
+
+#endif

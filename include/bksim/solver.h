@@ -1,0 +1,64 @@
+/* Solver back-ends: each is one file exporting one const bk_solver_backend.  Back-ends
+ * only integrate; the run loop owns the mode machine, the roots' meaning and the output.
+ *
+ * The problem handed to a back-end is a smooth ODE y' = f(t, y) of size n with nroots root
+ * functions g(t, y); the run loop changes n, f's meaning and the root directions between
+ * (re)starts. */
+#ifndef BKSIM_SOLVER_H
+#define BKSIM_SOLVER_H
+
+#include <stddef.h>
+
+#include "bksim/config.h"
+#include "bksim/status.h"
+
+typedef struct bk_ode_problem {
+    void *user;
+    /* Return 0 on success, > 0 for a recoverable failure, < 0 to abort. */
+    int (*rhs)(double t, const double *y, double *ydot, void *user);
+    int (*roots)(double t, const double *y, double *g, void *user);
+    size_t n_roots;
+    const int *root_direction; /* n_roots: +1 rising only, -1 falling only, 0 both */
+    size_t half_bandwidth;     /* Jacobian bandwidth each side, for band solvers */
+} bk_ode_problem;
+
+typedef struct bk_solver_counters {
+    long steps, rhs_evals, root_evals, err_test_fails, nonlin_iters;
+} bk_solver_counters;
+
+enum {
+    BK_STEP_OK = 0,      /* a step was taken; *t_reached < t_stop */
+    BK_STEP_ROOT = 1,    /* a root was found at *t_reached; y holds the state there */
+    BK_STEP_STOP = 2     /* reached t_stop exactly */
+};
+
+typedef struct bk_solver_backend {
+    const char *name;  /* value of [solver] method */
+    const char *doc;
+    /* Prepare for problems of size n; *mem owns everything. */
+    int (*create)(void **mem, const bk_solver_options *options, bk_error *err);
+    /* (Re)start at t0 from y0 (size n; may differ from the last start) with per-component
+     * absolute tolerances atol (size n). */
+    int (*start)(void *mem, const bk_ode_problem *problem, double t0, const double *y0,
+                 const double *atol, size_t n, double t_stop, bk_error *err);
+    /* One internal step toward t_stop; returns BK_STEP_* or a negative error. y (size n)
+     * receives the state at *t_reached. */
+    int (*step)(void *mem, double *t_reached, double *y, bk_error *err);
+    /* Dense output inside the last step: y(t) into y. */
+    int (*interpolate)(void *mem, double t, double *y, bk_error *err);
+    /* Interval [t_lo, t_hi] of the last step (where interpolate is valid). */
+    void (*last_step)(void *mem, double *t_lo, double *t_hi);
+    /* After BK_STEP_ROOT: found[i] = +1 / -1 for roots crossed rising / falling, else 0. */
+    int (*root_info)(void *mem, int *found);
+    void (*counters)(void *mem, bk_solver_counters *counters); /* cumulative over starts */
+    void (*destroy)(void *mem);
+} bk_solver_backend;
+
+const bk_solver_backend *bk_solver_backend_find(const char *name);
+/* All registered back-ends, NULL-terminated. */
+const bk_solver_backend *const *bk_solver_backends(void);
+
+extern const bk_solver_backend bk_solver_cvode_adams;
+extern const bk_solver_backend bk_solver_cvode_bdf;
+
+#endif

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Position (top) and velocity (bottom) of block 0 and the driver against time.
+# usage: plot_kinematics.sh OUT.png "TITLE" RUN.h5:LABEL:COLOR [RUN.h5:LABEL:COLOR]...
+# The driver (grey) is taken from the first run.  Data come through `bksim export`.
+set -euo pipefail
+bksim=${BKSIM:-./bksim}
+out=$1; title=$2; shift 2
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+
+pos_plot=""; vel_plot=""; k=0
+for spec in "$@"; do
+    IFS=: read -r file label color <<<"$spec"
+    # Column 5: driver velocity by finite differences over rows at least 1 us apart.
+    "$bksim" export "$file" --datasets time,driver,x,v --block 0 |
+        awk '/^#/ {next} { if (n++ && $1 - t > 1e-6) u = ($2 - d) / ($1 - t)
+                           if (n == 1 || $1 - t > 1e-6) { t = $1; d = $2 }
+                           print $0, (n > 1 ? u : "NaN") }' > "$tmp/$k.dat"
+    if [ $k -eq 0 ]; then
+        pos_plot="'$tmp/0.dat' using 1:(\$2*1e3) with lines lc rgb '#999999' lw 2 title 'driver'"
+        vel_plot="'$tmp/0.dat' using 1:(\$5*1e3) with lines lc rgb '#999999' lw 2 title 'driver'"
+    fi
+    pos_plot="$pos_plot, '$tmp/$k.dat' using 1:(\$3*1e3) with lines lc rgb '$color' lw 1.5 title '$label'"
+    vel_plot="$vel_plot, '$tmp/$k.dat' using 1:(\$4*1e3) with lines lc rgb '$color' lw 1.5 title '$label'"
+    k=$((k + 1))
+done
+
+gnuplot <<GP
+set terminal pngcairo size 1200,800 font 'Sans,13'
+set output '$out'
+set multiplot layout 2,1 title '$title'
+set grid
+set key top left
+set ylabel 'position [mm]'
+set format x ''
+plot $pos_plot
+set format x '%g'
+set xlabel 'time [s]'
+set ylabel 'velocity [mm/s]'
+plot $vel_plot
+unset multiplot
+GP

@@ -1,0 +1,369 @@
+/* bksim command line: a thin client of the library.  The only place that calls exit.
+ *
+ * Exit status: 0 success, 1 the run or the file failed, 2 bad usage or bad config. */
+#include <errno.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "bksim/bksim.h"
+
+enum { EXIT_RUN_FAILED = 1, EXIT_USAGE = 2 };
+
+static const char *const usage_text =
+    "usage: bksim <command> [options]\n"
+    "\n"
+    "commands:\n"
+    "  run CONFIG [-o OUT] [--set section.key=value]... [--quiet]\n"
+    "                       simulate the scene CONFIG describes, write HDF5 to OUT\n"
+    "                       (default: [output] path)\n"
+    "  check CONFIG [--set section.key=value]...\n"
+    "                       validate CONFIG without running\n"
+    "  info OUT.h5          summarise an output file\n"
+    "  export OUT.h5 [--datasets a,b,...] [--block I] [--transitions]\n"
+    "                       print columns for gnuplot and shell tools\n"
+    "  keys                 print the config key reference (Markdown)\n"
+    "  --version            print the version\n"
+    "\n"
+    "`bksim <command> --help` describes one command.\n";
+
+static const char *const run_help =
+    "usage: bksim run CONFIG [-o OUT] [--set section.key=value]... [--quiet]\n"
+    "\n"
+    "Runs the scene described by the INI file CONFIG and writes an HDF5 time series.\n"
+    "  -o, --output OUT   output path (overrides [output] path)\n"
+    "  --set S.K=V        override key K of section S after reading CONFIG; S may be\n"
+    "                     block.3 or friction.3 for one block (repeatable)\n"
+    "  -q, --quiet        no progress indicator and no summary\n"
+    "The file is written as OUT.part and renamed to OUT when the run completes; a failed\n"
+    "or interrupted run leaves OUT.part marked complete = 0.\n";
+
+static const char *const check_help =
+    "usage: bksim check CONFIG [--set section.key=value]...\n"
+    "\n"
+    "Validates CONFIG (and the overrides) exactly as `run` would, writes nothing.\n";
+
+static const char *const info_help =
+    "usage: bksim info OUT.h5\n"
+    "\n"
+    "Prints the parameters, stick/slip phase counts per block, and solver statistics.\n";
+
+static const char *const export_help =
+    "usage: bksim export OUT.h5 [--datasets a,b,...] [--block I] [--transitions]\n"
+    "\n"
+    "Prints whitespace-separated columns with a '#' header (names and units).\n"
+    "  --datasets LIST   comma-separated dataset names (default time,driver,x,v,friction,\n"
+    "                    cof,mode); per-block datasets give one column per block\n"
+    "  --block I         only block I (0-based) of the per-block datasets\n"
+    "  --transitions     print the /transitions table instead\n";
+
+static const char *const keys_help =
+    "usage: bksim keys\n"
+    "\n"
+    "Prints every config key (section, unit, default, allowed range, meaning) as Markdown.\n";
+
+static volatile sig_atomic_t stop_requested = 0;
+
+static void on_signal(int signo)
+{
+    (void)signo;
+    stop_requested = 1;
+}
+
+static int wants_help(int argc, char **argv)
+{
+    for (int i = 0; i < argc; ++i)
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0)
+            return 1;
+    return 0;
+}
+
+static int usage_error(const char *command, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
+static int usage_error(const char *command, const char *fmt, ...)
+{
+    fprintf(stderr, "bksim %s: ", command);
+    va_list ap;
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\n(see `bksim %s --help`)\n", command);
+    return EXIT_USAGE;
+}
+
+/* Options shared by run and check. */
+typedef struct config_args {
+    const char *config_path;
+    const char *output;
+    const char **overrides;
+    size_t n_overrides;
+    int quiet;
+} config_args;
+
+static int parse_config_args(const char *command, int argc, char **argv, config_args *args)
+{
+    memset(args, 0, sizeof *args);
+    args->overrides = calloc((size_t)argc + 1, sizeof *args->overrides);
+    if (!args->overrides) {
+        fprintf(stderr, "bksim: out of memory\n");
+        return EXIT_RUN_FAILED;
+    }
+    int allow_output = strcmp(command, "run") == 0;
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        if (strcmp(a, "--set") == 0) {
+            if (i + 1 >= argc)
+                return usage_error(command, "%s needs section.key=value", a);
+            args->overrides[args->n_overrides++] = argv[++i];
+        } else if (strncmp(a, "--set=", 6) == 0) {
+            args->overrides[args->n_overrides++] = a + 6;
+        } else if (allow_output && (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0)) {
+            if (i + 1 >= argc)
+                return usage_error(command, "%s needs a path", a);
+            args->output = argv[++i];
+        } else if (allow_output && (strcmp(a, "-q") == 0 || strcmp(a, "--quiet") == 0)) {
+            args->quiet = 1;
+        } else if (a[0] == '-' && a[1] != '\0') {
+            return usage_error(command, "unknown option '%s'", a);
+        } else if (!args->config_path) {
+            args->config_path = a;
+        } else {
+            return usage_error(command, "unexpected argument '%s'", a);
+        }
+    }
+    if (!args->config_path)
+        return usage_error(command, "%s", "missing CONFIG");
+    return 0;
+}
+
+static int load_config(const config_args *args, bk_config **config)
+{
+    bk_error err = {0};
+    int rc = bk_config_load_file(args->config_path, args->overrides, args->n_overrides, config, &err);
+    if (rc != BK_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return rc == BK_ERR_CONFIG ? EXIT_USAGE : EXIT_RUN_FAILED;
+    }
+    return 0;
+}
+
+/* The shared start of run and check: help, arguments, the config.  Returns -1 when help
+ * was printed (exit 0), else an exit status (0: go on with *config loaded). */
+static int prepare(const char *command, const char *help, int argc, char **argv, config_args *args,
+                   bk_config **config)
+{
+    *config = NULL;
+    args->overrides = NULL;
+    if (wants_help(argc, argv)) {
+        fputs(help, stdout);
+        return -1;
+    }
+    int status = parse_config_args(command, argc, argv, args);
+    if (status == 0)
+        status = load_config(args, config);
+    return status;
+}
+
+static int cmd_check(int argc, char **argv)
+{
+    config_args args;
+    bk_config *config = NULL;
+    int status = prepare("check", check_help, argc, argv, &args, &config);
+    if (status < 0)
+        return 0;
+    if (status == 0) {
+        const bk_model *m = config->model;
+        printf("%s: ok: %zu block%s, %s boundary, %s driver spring, driver %g m/s, t_end %g s, "
+               "method %s, output %s\n",
+               args.config_path, m->n_blocks, m->n_blocks == 1 ? "" : "s",
+               m->boundary == BK_BOUNDARY_FREE    ? "free"
+               : m->boundary == BK_BOUNDARY_FIXED ? "fixed"
+                                                  : "periodic",
+               m->spring == BK_SPRING_LINEAR ? "linear" : "tension-only", m->driver.velocity,
+               config->t_end, config->solver.method, config->output.path);
+    }
+    bk_config_free(config);
+    free(args.overrides);
+    return status;
+}
+
+/* Progress on a terminal, for runs longer than a second. */
+typedef struct progress_state {
+    int enabled;
+    double start, last_print;
+    int printed;
+} progress_state;
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int show_progress(void *user, double t, double t_end)
+{
+    progress_state *p = user;
+    if (stop_requested)
+        return 1;
+    if (!p->enabled)
+        return 0;
+    double now = now_seconds();
+    if (now - p->start < 1.0 || now - p->last_print < 0.1)
+        return 0;
+    p->last_print = now;
+    p->printed = 1;
+    fprintf(stderr, "\rbksim: t = %.6g s of %g s (%3.0f%%), %.0f s elapsed ", t, t_end,
+            100.0 * t / t_end, now - p->start);
+    fflush(stderr);
+    return 0;
+}
+
+static int cmd_run(int argc, char **argv)
+{
+    config_args args;
+    bk_config *config = NULL;
+    int status = prepare("run", run_help, argc, argv, &args, &config);
+    if (status < 0)
+        return 0;
+    if (status != 0) {
+        free(args.overrides);
+        return status;
+    }
+    const char *path = args.output ? args.output : config->output.path;
+    bk_error err = {0};
+    bk_h5_writer *writer = NULL;
+    if (bk_h5_writer_open(&writer, config, path, &err) != BK_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        bk_config_free(config);
+        free(args.overrides);
+        return EXIT_RUN_FAILED;
+    }
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
+    progress_state progress = {!args.quiet && isatty(STDERR_FILENO), now_seconds(), 0.0, 0};
+    bk_sink sink = bk_h5_writer_sink(writer);
+    bk_run_stats stats;
+    int rc = bk_run(config, &sink, &stats, show_progress, &progress, &err);
+    if (progress.printed)
+        fputs("\n", stderr);
+    if (rc != BK_OK) {
+        fprintf(stderr, "%s: %s\n", args.config_path, err.message);
+        bk_h5_writer_abandon(writer, err.message, &stats);
+        fprintf(stderr, "bksim: partial output left in %s.part (complete = 0)\n", path);
+        status = EXIT_RUN_FAILED;
+    } else if (bk_h5_writer_finish(writer, &stats, &err) != BK_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        status = EXIT_RUN_FAILED;
+    } else if (!args.quiet) {
+        printf("%s: %ld rows, %ld transitions, t = %g s, %ld steps, %ld RHS evaluations, "
+               "energy residual %.2g, %.3f s CPU\n",
+               path, stats.rows, stats.transitions, stats.t_reached, stats.steps, stats.rhs_evals,
+               stats.energy_residual, stats.cpu_time);
+    }
+    bk_config_free(config);
+    free(args.overrides);
+    return status;
+}
+
+static int cmd_info(int argc, char **argv)
+{
+    if (wants_help(argc, argv)) {
+        fputs(info_help, stdout);
+        return 0;
+    }
+    if (argc != 1)
+        return usage_error("info", "%s", argc == 0 ? "missing OUT.h5" : "expects exactly one file");
+    bk_error err = {0};
+    if (bk_h5_info(argv[0], stdout, &err) != BK_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return EXIT_RUN_FAILED;
+    }
+    return 0;
+}
+
+static int cmd_export(int argc, char **argv)
+{
+    if (wants_help(argc, argv)) {
+        fputs(export_help, stdout);
+        return 0;
+    }
+    const char *path = NULL, *datasets = NULL;
+    long block = -1;
+    int transitions = 0;
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        if (strcmp(a, "--datasets") == 0 && i + 1 < argc) {
+            datasets = argv[++i];
+        } else if (strncmp(a, "--datasets=", 11) == 0) {
+            datasets = a + 11;
+        } else if ((strcmp(a, "--block") == 0 && i + 1 < argc) || strncmp(a, "--block=", 8) == 0) {
+            const char *text = a[7] == '=' ? a + 8 : argv[++i];
+            char *end = NULL;
+            errno = 0;
+            block = strtol(text, &end, 10);
+            if (errno || end == text || *end != '\0' || block < 0)
+                return usage_error("export", "--block needs a block index >= 0, got '%s'", text);
+        } else if (strcmp(a, "--transitions") == 0) {
+            transitions = 1;
+        } else if (a[0] == '-') {
+            return usage_error("export", "unknown or incomplete option '%s'", a);
+        } else if (!path) {
+            path = a;
+        } else {
+            return usage_error("export", "unexpected argument '%s'", a);
+        }
+    }
+    if (!path)
+        return usage_error("export", "%s", "missing OUT.h5");
+    bk_error err = {0};
+    if (bk_h5_export(path, datasets, block, transitions, stdout, &err) != BK_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return EXIT_RUN_FAILED;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fputs(usage_text, stderr);
+        return EXIT_USAGE;
+    }
+    const char *command = argv[1];
+    int rest = argc - 2;
+    char **rest_argv = argv + 2;
+    if (strcmp(command, "run") == 0)
+        return cmd_run(rest, rest_argv);
+    if (strcmp(command, "check") == 0)
+        return cmd_check(rest, rest_argv);
+    if (strcmp(command, "info") == 0)
+        return cmd_info(rest, rest_argv);
+    if (strcmp(command, "export") == 0)
+        return cmd_export(rest, rest_argv);
+    if (strcmp(command, "keys") == 0) {
+        if (wants_help(rest, rest_argv)) {
+            fputs(keys_help, stdout);
+            return 0;
+        }
+        bk_config_write_reference(stdout);
+        return 0;
+    }
+    if (strcmp(command, "--version") == 0 || strcmp(command, "version") == 0) {
+        printf("bksim %s\n", BKSIM_VERSION);
+        return 0;
+    }
+    if (strcmp(command, "--help") == 0 || strcmp(command, "-h") == 0 || strcmp(command, "help") == 0) {
+        fputs(usage_text, stdout);
+        return 0;
+    }
+    fprintf(stderr, "bksim: unknown command '%s'\n\n", command);
+    fputs(usage_text, stderr);
+    return EXIT_USAGE;
+}

@@ -1,0 +1,974 @@
+/* INI -> validated bk_config.  One table of keys (plus each friction law's parameter table)
+ * drives parsing, validation and the reference documentation.
+ *
+ * Parsing goes through inih with our own line reader, which counts lines (Debian's inih
+ * gives the handler none), strips leading whitespace (an indented line would otherwise be
+ * glued to the previous value as a continuation) and rejects over-long lines (inih would
+ * silently cut them).  Every entry is collected first, then checked; the error reported is
+ * the earliest in file order (then --set order), so a user fixes errors top to bottom. */
+#include "bksim/config.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include <ini.h>
+
+#include "bksim/solver.h"
+
+#define MAX_LINE_CHARS 190
+#define MAX_FILE_BYTES (1 << 20)
+#define MAX_BLOCKS 1000000L
+#define SECTION_LEN 64
+#define KEY_LEN 64
+
+/* --- the key table ---------------------------------------------------------------------- */
+
+typedef enum key_type { KEY_DOUBLE, KEY_INT, KEY_BOOL, KEY_ENUM, KEY_STRING, KEY_FIELDS } key_type;
+
+static const char *const boundary_names[] = {"free", "fixed", "periodic", NULL};
+static const char *const spring_names[] = {"linear", "tension_only", NULL};
+static const char *const linear_solver_names[] = {"auto", "dense", "band", NULL};
+static const char *const field_names[] = {"x", "v", "friction", "cof", "mode", "energy", "state", NULL};
+
+static const char *method_name(size_t i)
+{
+    const bk_solver_backend *const *b = bk_solver_backends();
+    for (size_t k = 0; b[k]; ++k)
+        if (k == i)
+            return b[k]->name;
+    return NULL;
+}
+
+static const char *law_name(size_t i)
+{
+    const bk_friction_law *const *l = bk_friction_laws();
+    for (size_t k = 0; l[k]; ++k)
+        if (k == i)
+            return l[k]->name;
+    return NULL;
+}
+
+typedef struct key_def {
+    const char *section;
+    bk_param param;               /* key, unit, default, range, flags, doc */
+    key_type type;
+    const char *const *choices;   /* KEY_ENUM with fixed words */
+    const char *(*choice)(size_t); /* KEY_ENUM with registered names */
+    const char *default_text;     /* for the reference when the default is not a number */
+} key_def;
+
+#define NUM(sec, k, unit, def, lo, hi, fl, doc) {sec, {k, unit, def, lo, hi, fl, doc}, KEY_DOUBLE, NULL, NULL, NULL}
+#define INT(sec, k, def, lo, hi, fl, doc) {sec, {k, "1", def, lo, hi, fl, doc}, KEY_INT, NULL, NULL, NULL}
+
+static const key_def keys[] = {
+    INT("model", "n_blocks", NAN, 1, MAX_BLOCKS, BK_PARAM_REQUIRED, "number of blocks in the chain"),
+    {"model", {"boundary", "", 0, 0, 0, 0, "chain ends: free, fixed (tied to walls at 0) or periodic (a ring)"},
+     KEY_ENUM, boundary_names, NULL, "free"},
+    NUM("model", "coupling_stiffness", "N/m", 0.0, 0.0, INFINITY, 0, "stiffness of the springs between neighbours"),
+    NUM("model", "gravity", "m/s^2", 9.81, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
+        "gravitational acceleration, for the default normal force"),
+
+    NUM("block", "mass", "kg", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE, "block mass"),
+    NUM("block", "driver_stiffness", "N/m", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED,
+        "stiffness of the spring from the driver to the block"),
+    {"block", {"normal_force", "N", NAN, 0.0, INFINITY, BK_PARAM_DERIVED | BK_PARAM_MIN_EXCLUSIVE,
+               "normal force on the block"}, KEY_DOUBLE, NULL, NULL, "mass * gravity"},
+    NUM("block", "x_init", "m", 0.0, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
+        "initial displacement from the relaxed configuration"),
+    NUM("block", "v_init", "m/s", 0.0, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
+        "initial velocity (non-zero: the block starts slipping that way)"),
+
+    {"friction", {"law", "", NAN, 0, 0, BK_PARAM_REQUIRED, "friction law; its parameters follow in the same section"},
+     KEY_ENUM, NULL, law_name, NULL},
+
+    NUM("driver", "velocity", "m/s", NAN, -INFINITY, INFINITY,
+        BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE, "driver velocity (constant)"),
+    {"driver", {"spring", "", 0, 0, 0, 0, "driver springs: linear, or tension_only (pull, never push; NOTES.md 3)"},
+     KEY_ENUM, spring_names, NULL, "linear"},
+    NUM("driver", "start_position", "m", 0.0, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
+        "driver position at t = 0 (0: at the relaxed blocks)"),
+
+    {"solver", {"method", "", 0, 0, 0, 0, "integrator back-end"}, KEY_ENUM, NULL, method_name, "cvode_adams"},
+    {"solver", {"linear_solver", "", 0, 0, 0, 0, "linear solver of implicit methods: auto (band for long chains), dense, band"},
+     KEY_ENUM, linear_solver_names, NULL, "auto"},
+    NUM("solver", "rtol", "1", 1e-8, 1e-15, 0.1, 0, "relative tolerance"),
+    {"solver", {"atol_x", "m", NAN, 0.0, INFINITY, BK_PARAM_DERIVED | BK_PARAM_MIN_EXCLUSIVE,
+                "absolute tolerance on positions"}, KEY_DOUBLE, NULL, NULL, "rtol * 1e-3 * max(F_s / k)"},
+    {"solver", {"atol_v", "m/s", NAN, 0.0, INFINITY, BK_PARAM_DERIVED | BK_PARAM_MIN_EXCLUSIVE,
+                "absolute tolerance on velocities"}, KEY_DOUBLE, NULL, NULL,
+     "rtol * 1e-3 * min(driver speed, max(F_s / k) * omega_max)"},
+    {"solver", {"max_step", "s", NAN, 0.0, INFINITY, BK_PARAM_DERIVED | BK_PARAM_MIN_EXCLUSIVE,
+                "largest integrator step (keeps a slip-rate extremum from hiding inside a step)"},
+     KEY_DOUBLE, NULL, NULL, "1/8 of the fastest natural period"},
+    INT("solver", "max_steps", 100000, 1, INT_MAX, 0, "integrator steps allowed between two output rows"),
+    {"solver", {"detect_velocity_extrema", "", 1, 0, 1, 0,
+                "locate slip-rate minima to catch a stop hidden inside one step"}, KEY_BOOL, NULL, NULL, "true"},
+    INT("solver", "max_transitions_per_instant", 100, 1, INT_MAX, 0,
+        "transitions of one block within instant_window before the run stops as chattering"),
+    {"solver", {"instant_window", "s", NAN, 0.0, INFINITY, BK_PARAM_DERIVED | BK_PARAM_MIN_EXCLUSIVE,
+                "transitions closer than this count as one instant"}, KEY_DOUBLE, NULL, NULL,
+     "1e-6 of the fastest natural period"},
+
+    {"output", {"path", "", 0, 0, 0, 0, "HDF5 output file (bksim run -o overrides)"}, KEY_STRING, NULL, NULL,
+     "config file name, .ini replaced by .h5"},
+    {"output", {"interval", "s", NAN, 0.0, INFINITY, BK_PARAM_DERIVED,
+                "time between samples, <= t_end; 0: rows only at transitions (and t = 0, t_end)"},
+     KEY_DOUBLE, NULL, NULL, "t_end / 1000"},
+    {"output", {"fields", "", 0, 0, 0, 0, "per-row datasets: all, or a list of x v friction cof mode energy state"},
+     KEY_FIELDS, field_names, NULL, "all"},
+    {"output", {"transitions", "", 1, 0, 1, 0, "write the /transitions table"}, KEY_BOOL, NULL, NULL, "true"},
+    {"output", {"event_rows", "", 1, 0, 1, 0, "add a row at every transition instant"}, KEY_BOOL, NULL, NULL, "true"},
+
+    NUM("run", "t_end", "s", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE, "end time (runs from 0)"),
+};
+#define N_KEYS (sizeof keys / sizeof keys[0])
+
+static const char *const sections[] = {"model", "block", "friction", "driver", "solver", "output", "run", NULL};
+
+static const key_def *find_key(const char *section, const char *key)
+{
+    for (size_t i = 0; i < N_KEYS; ++i)
+        if (strcmp(keys[i].section, section) == 0 && strcmp(keys[i].param.key, key) == 0)
+            return &keys[i];
+    return NULL;
+}
+
+static const char *enum_choice(const key_def *def, size_t i)
+{
+    return def->choice ? def->choice(i) : def->choices[i];
+}
+
+/* --- collected entries ------------------------------------------------------------------ */
+
+typedef struct entry {
+    char section[SECTION_LEN]; /* as written, e.g. "block.3" */
+    char base[SECTION_LEN];    /* "block" */
+    long index;                /* block index of a per-block section, -1 otherwise */
+    char key[KEY_LEN];
+    char *value;
+    int line;                  /* file line, or 0 for an override */
+    int section_line;          /* line of the section's header (0: none, or an override) */
+    const char *override;      /* the --set text, or NULL */
+    long rank;                 /* position for "first error" */
+    int superseded;            /* replaced by a later override */
+    double number;             /* parsed value (numbers, bools, enum index) */
+} entry;
+
+typedef struct loader {
+    const char *name;          /* config file name for messages */
+    entry *entries;
+    size_t n, cap;
+    long error_rank;           /* rank of the recorded error, LONG_MAX when none */
+    bk_error *err;
+    int status;
+    /* reader state */
+    const char *text, *cursor;
+    int line;
+    int section_line;          /* line of the last [section] header read */
+    int oom;
+} loader;
+
+#define RANK_MISSING (LONG_MAX - 1)
+
+/* Record a failure at `rank` unless an earlier one is already recorded. */
+static void report(loader *ld, long rank, int status, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+static void report(loader *ld, long rank, int status, const char *fmt, ...)
+{
+    if (rank >= ld->error_rank)
+        return;
+    ld->error_rank = rank;
+    ld->status = status;
+    char buf[BK_ERROR_MESSAGE_LEN];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    BK_FAIL(ld->err, status, "%s", buf);
+}
+
+/* "file:12" or "--set block.mass=0". */
+static void location(const loader *ld, const entry *e, char *buf, size_t len)
+{
+    if (e->override)
+        snprintf(buf, len, "--set %s", e->override);
+    else
+        snprintf(buf, len, "%s:%d", ld->name, e->line);
+}
+
+/* Where a section was opened: its header line, or the entry's own location. */
+static void section_location(const loader *ld, const entry *e, char *buf, size_t len)
+{
+    if (e->override || !e->section_line)
+        location(ld, e, buf, len);
+    else
+        snprintf(buf, len, "%s:%d", ld->name, e->section_line);
+}
+
+static void report_entry(loader *ld, const entry *e, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static void report_entry(loader *ld, const entry *e, const char *fmt, ...)
+{
+    if (e->rank >= ld->error_rank)
+        return;
+    char where[512], what[768];
+    location(ld, e, where, sizeof where);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    report(ld, e->rank, BK_ERR_CONFIG, "%s: [%s] %s: %s", where, e->section, e->key, what);
+}
+
+/* Split "block.3" into base "block" and index 3; -1 for plain sections, -2 if malformed. */
+static long split_section(const char *section, char *base, size_t len)
+{
+    const char *dot = strchr(section, '.');
+    if (!dot) {
+        snprintf(base, len, "%s", section);
+        return -1;
+    }
+    snprintf(base, len, "%.*s", (int)(dot - section), section);
+    const char *digits = dot + 1;
+    if (!*digits)
+        return -2;
+    for (const char *p = digits; *p; ++p)
+        if (!isdigit((unsigned char)*p))
+            return -2;
+    errno = 0;
+    long index = strtol(digits, NULL, 10);
+    return errno ? -2 : index;
+}
+
+static int add_entry(loader *ld, const char *section, const char *key, const char *value, int line,
+                     const char *override, long rank)
+{
+    if (ld->n == ld->cap) {
+        size_t cap = ld->cap ? 2 * ld->cap : 32;
+        entry *grown = realloc(ld->entries, cap * sizeof *grown);
+        if (!grown)
+            return -1;
+        ld->entries = grown;
+        ld->cap = cap;
+    }
+    entry *e = &ld->entries[ld->n];
+    memset(e, 0, sizeof *e);
+    e->value = strdup(value);
+    if (!e->value)
+        return -1;
+    ld->n++;
+    snprintf(e->section, sizeof e->section, "%s", section);
+    snprintf(e->key, sizeof e->key, "%s", key);
+    e->index = split_section(section, e->base, sizeof e->base);
+    e->line = line;
+    e->override = override;
+    e->rank = rank;
+    return 0;
+}
+
+/* fgets-style reader over the text in memory (see the file comment). */
+static char *read_line(char *str, int num, void *stream)
+{
+    loader *ld = stream;
+    if (!*ld->cursor)
+        return NULL;
+    const char *start = ld->cursor;
+    const char *eol = strchr(start, '\n');
+    size_t len = eol ? (size_t)(eol - start) + 1 : strlen(start);
+    ld->cursor = start + len;
+    ld->line++;
+    size_t content = len - (eol ? 1 : 0);
+    if (content > 0 && start[content - 1] == '\r')
+        content--;
+    if (content > MAX_LINE_CHARS) {
+        char where[300];
+        snprintf(where, sizeof where, "%s:%d", ld->name, ld->line);
+        report(ld, ld->line, BK_ERR_CONFIG, "%s: line longer than %d characters (%zu); split it",
+               where, MAX_LINE_CHARS, content);
+        content = 0;
+    }
+    while (content > 0 && (*start == ' ' || *start == '\t')) {
+        ++start;
+        --content;
+    }
+    if (content > 0 && *start == '[')
+        ld->section_line = ld->line;
+    if ((int)content + 2 > num)
+        content = (size_t)num - 2;
+    memcpy(str, start, content);
+    str[content] = '\n';
+    str[content + 1] = '\0';
+    return str;
+}
+
+static int on_pair(void *user, const char *section, const char *key, const char *value)
+{
+    loader *ld = user;
+    if (add_entry(ld, section, key, value, ld->line, NULL, ld->line) != 0)
+        ld->oom = 1;
+    else
+        ld->entries[ld->n - 1].section_line = ld->section_line;
+    return 1;
+}
+
+/* --- values ----------------------------------------------------------------------------- */
+
+static void format_allowed(const key_def *def, const bk_param *param, char *buf, size_t len)
+{
+    if (!def || def->type == KEY_DOUBLE || def->type == KEY_INT) {
+        bk_param_format_range(param, buf, len);
+        if (def && def->type == KEY_INT) {
+            size_t used = strlen(buf);
+            snprintf(buf + used, len - used, ", an integer");
+        }
+        return;
+    }
+    if (def->type == KEY_BOOL) {
+        snprintf(buf, len, "true, false, yes, no, on, off, 1, 0");
+        return;
+    }
+    if (def->type == KEY_STRING) {
+        snprintf(buf, len, "a non-empty text");
+        return;
+    }
+    size_t used = 0;
+    buf[0] = '\0';
+    if (def->type == KEY_FIELDS)
+        used += (size_t)snprintf(buf, len, "all, or a list of ");
+    for (size_t i = 0; enum_choice(def, i) && used < len; ++i)
+        used += (size_t)snprintf(buf + used, len - used, "%s%s", i ? ", " : "", enum_choice(def, i));
+}
+
+static int parse_number(const char *text, double *out)
+{
+    if (!*text)
+        return -1;
+    char *end = NULL;
+    errno = 0;
+    double value = strtod(text, &end);
+    while (end && isspace((unsigned char)*end))
+        ++end;
+    if (end == text || *end != '\0' || errno == ERANGE || !isfinite(value))
+        return -1;
+    *out = value;
+    return 0;
+}
+
+static int parse_integer(const char *text, double *out)
+{
+    const char *p = text;
+    if (*p == '+' || *p == '-')
+        ++p;
+    if (!isdigit((unsigned char)*p))
+        return -1;
+    for (const char *q = p; *q; ++q)
+        if (!isdigit((unsigned char)*q))
+            return -1;
+    errno = 0;
+    long long value = strtoll(text, NULL, 10);
+    if (errno == ERANGE)
+        return -1;
+    *out = (double)value;
+    return 0;
+}
+
+static int parse_bool(const char *text, double *out)
+{
+    static const char *const yes[] = {"true", "yes", "on", "1"}, *const no[] = {"false", "no", "off", "0"};
+    for (size_t i = 0; i < 4; ++i) {
+        if (strcasecmp(text, yes[i]) == 0) {
+            *out = 1;
+            return 0;
+        }
+        if (strcasecmp(text, no[i]) == 0) {
+            *out = 0;
+            return 0;
+        }
+    }
+    return -1;
+}
+
+/* Parse a "fields" list into a BK_FIELD_* mask; -1 and the bad word on failure. */
+static int parse_fields(const char *text, double *out, char *bad, size_t bad_len)
+{
+    unsigned mask = 0;
+    const char *p = text;
+    int words = 0;
+    while (*p) {
+        while (*p == ',' || isspace((unsigned char)*p))
+            ++p;
+        if (!*p)
+            break;
+        const char *start = p;
+        while (*p && *p != ',' && !isspace((unsigned char)*p))
+            ++p;
+        size_t len = (size_t)(p - start);
+        ++words;
+        if (len == 3 && strncmp(start, "all", 3) == 0) {
+            mask = BK_FIELD_ALL;
+            continue;
+        }
+        size_t i = 0;
+        for (; field_names[i]; ++i)
+            if (strlen(field_names[i]) == len && strncmp(field_names[i], start, len) == 0)
+                break;
+        if (!field_names[i]) {
+            snprintf(bad, bad_len, "%.*s", (int)len, start);
+            return -1;
+        }
+        mask |= 1u << i;
+    }
+    if (!words) {
+        snprintf(bad, bad_len, "(empty)");
+        return -1;
+    }
+    *out = (double)mask;
+    return 0;
+}
+
+/* Parse and range-check an entry's value against its definition; reports on failure. */
+static int check_value(loader *ld, entry *e, const key_def *def, const bk_param *param)
+{
+    char allowed[512];
+    format_allowed(def, param, allowed, sizeof allowed);
+    key_type type = def ? def->type : KEY_DOUBLE;
+    const char *v = e->value;
+    switch (type) {
+    case KEY_DOUBLE:
+    case KEY_INT: {
+        int bad = type == KEY_INT ? parse_integer(v, &e->number) : parse_number(v, &e->number);
+        if (bad) {
+            const char *hint = strchr(v, '#') ? " (inline comments start with ';')" : "";
+            report_entry(ld, e, "%s \"%s\"%s (allowed: %s)",
+                         type == KEY_INT ? "not an integer:" : "not a number:", v, hint, allowed);
+            return -1;
+        }
+        if (!bk_param_in_range(param, e->number)) {
+            report_entry(ld, e, "out of range, got %s (allowed: %s)", v, allowed);
+            return -1;
+        }
+        return 0;
+    }
+    case KEY_BOOL:
+        if (parse_bool(v, &e->number)) {
+            report_entry(ld, e, "not a boolean: \"%s\" (allowed: %s)", v, allowed);
+            return -1;
+        }
+        return 0;
+    case KEY_ENUM:
+        for (size_t i = 0; enum_choice(def, i); ++i)
+            if (strcmp(enum_choice(def, i), v) == 0) {
+                e->number = (double)i;
+                return 0;
+            }
+        report_entry(ld, e, "unknown value \"%s\" (allowed: %s)", v, allowed);
+        return -1;
+    case KEY_STRING:
+        if (!*v) {
+            report_entry(ld, e, "empty value (allowed: %s)", allowed);
+            return -1;
+        }
+        return 0;
+    case KEY_FIELDS: {
+        char bad[64];
+        if (parse_fields(v, &e->number, bad, sizeof bad)) {
+            report_entry(ld, e, "unknown field \"%s\" (allowed: %s)", bad, allowed);
+            return -1;
+        }
+        return 0;
+    }
+    }
+    return -1;
+}
+
+/* The last (not superseded) entry for section/key, or NULL. */
+static entry *lookup(loader *ld, const char *section, const char *key)
+{
+    for (size_t i = ld->n; i-- > 0;) {
+        entry *e = &ld->entries[i];
+        if (!e->superseded && strcmp(e->section, section) == 0 && strcmp(e->key, key) == 0)
+            return e;
+    }
+    return NULL;
+}
+
+static void list_keys(const char *section, char *buf, size_t len)
+{
+    size_t used = 0;
+    buf[0] = '\0';
+    for (size_t i = 0; i < N_KEYS && used < len; ++i)
+        if (strcmp(keys[i].section, section) == 0)
+            used += (size_t)snprintf(buf + used, len - used, "%s%s", used ? ", " : "", keys[i].param.key);
+}
+
+static void list_law_params(const bk_friction_law *law, char *buf, size_t len)
+{
+    size_t used = 0;
+    buf[0] = '\0';
+    for (size_t i = 0; i < law->n_params && used < len; ++i)
+        used += (size_t)snprintf(buf + used, len - used, "%s%s", i ? ", " : "", law->params[i].key);
+}
+
+/* The law a friction section uses: its own `law` entry, or for [friction.I] the base's. */
+static const bk_friction_law *section_law(loader *ld, const entry *e)
+{
+    entry *own = lookup(ld, e->section, "law");
+    if (!own && e->index >= 0)
+        own = lookup(ld, "friction", "law");
+    return own ? bk_friction_law_find(own->value) : NULL;
+}
+
+/* --- checks ----------------------------------------------------------------------------- */
+
+/* Sections, keys, duplicates and every value on its own. */
+static void check_entries(loader *ld, long n_blocks)
+{
+    char allowed[512];
+    for (size_t i = 0; i < ld->n; ++i) {
+        entry *e = &ld->entries[i];
+        if (e->superseded)
+            continue;
+        int known_section = 0;
+        for (size_t s = 0; sections[s]; ++s)
+            known_section |= strcmp(sections[s], e->base) == 0;
+        int per_block_ok = strcmp(e->base, "block") == 0 || strcmp(e->base, "friction") == 0;
+        if (!known_section || e->index == -2 || (e->index >= 0 && !per_block_ok)) {
+            char where[512];
+            section_location(ld, e, where, sizeof where);
+            report(ld, e->section_line ? e->section_line : e->rank, BK_ERR_CONFIG,
+                   "%s: [%s]: unknown section (allowed: model, block, block.I, friction, friction.I, "
+                   "driver, solver, output, run; I is a block index from 0)",
+                   where, e->section);
+            continue;
+        }
+        if (e->index >= 0 && n_blocks > 0 && e->index >= n_blocks) {
+            char where[512];
+            section_location(ld, e, where, sizeof where);
+            report(ld, e->section_line ? e->section_line : e->rank, BK_ERR_CONFIG, "%s: [%s]: block index out of range (allowed: 0..%ld)",
+                   where, e->section, n_blocks - 1);
+            continue;
+        }
+        /* A key given twice in one section of the file. */
+        for (size_t j = 0; j < i; ++j) {
+            entry *f = &ld->entries[j];
+            if (!f->superseded && !f->override && !e->override && strcmp(f->section, e->section) == 0 &&
+                strcmp(f->key, e->key) == 0) {
+                report_entry(ld, e, "duplicate key (first set at line %d)", f->line);
+                break;
+            }
+        }
+        const key_def *def = find_key(e->base, e->key);
+        if (def) {
+            check_value(ld, e, def, &def->param);
+            continue;
+        }
+        if (strcmp(e->base, "friction") == 0) {
+            const bk_friction_law *law = section_law(ld, e);
+            if (!law)
+                continue; /* the missing or unknown law is reported at its own line */
+            int p = bk_friction_param_index(law, e->key);
+            if (p < 0) {
+                list_law_params(law, allowed, sizeof allowed);
+                report_entry(ld, e, "not a parameter of law '%s' (known: law, %s)", law->name, allowed);
+                continue;
+            }
+            check_value(ld, e, NULL, &law->params[p]);
+            continue;
+        }
+        list_keys(e->base, allowed, sizeof allowed);
+        report_entry(ld, e, "unknown key (allowed: %s)", allowed);
+    }
+}
+
+static void report_missing(loader *ld, const char *section, const bk_param *param, const key_def *def)
+{
+    char allowed[512];
+    format_allowed(def, param, allowed, sizeof allowed);
+    report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [%s] %s: required key missing (allowed: %s)", ld->name,
+           section, param->key, allowed);
+}
+
+/* Value of a key in [section] (checked), or the definition's default. */
+static double value_of(loader *ld, const char *section, const char *key)
+{
+    entry *e = lookup(ld, section, key);
+    if (e)
+        return e->number;
+    const key_def *def = find_key(section, key);
+    if (def->type == KEY_ENUM && def->default_text)
+        for (size_t i = 0; enum_choice(def, i); ++i)
+            if (strcmp(enum_choice(def, i), def->default_text) == 0)
+                return (double)i;
+    if (def->type == KEY_FIELDS)
+        return (double)BK_FIELD_ALL;
+    if (def->param.flags & BK_PARAM_REQUIRED)
+        report_missing(ld, section, &def->param, def);
+    return def->param.default_value;
+}
+
+/* A block key: [block.I] over [block] over the default. */
+static double block_value(loader *ld, size_t i, const char *key, int *given)
+{
+    char section[SECTION_LEN];
+    snprintf(section, sizeof section, "block.%zu", i);
+    entry *e = lookup(ld, section, key);
+    if (!e)
+        e = lookup(ld, "block", key);
+    *given = e != NULL;
+    return e ? e->number : find_key("block", key)->param.default_value;
+}
+
+/* Friction of block i: its law and parameters, completed and validated. */
+static void build_friction(loader *ld, bk_block *b, size_t i, double driver_speed)
+{
+    char section[SECTION_LEN];
+    snprintf(section, sizeof section, "friction.%zu", i);
+    entry *own_law = lookup(ld, section, "law");
+    entry *base_law = lookup(ld, "friction", "law");
+    entry *law_entry = own_law ? own_law : base_law;
+    if (!law_entry) {
+        report_missing(ld, "friction", &find_key("friction", "law")->param, find_key("friction", "law"));
+        return;
+    }
+    const bk_friction_law *law = bk_friction_law_find(law_entry->value);
+    if (!law)
+        return; /* reported at its line */
+    /* Parameters of [friction] apply unless this block names a different law. */
+    int inherit = !own_law || (base_law && strcmp(own_law->value, base_law->value) == 0);
+    const char *param_section = own_law ? section : "friction";
+    entry *origin[BK_FRICTION_MAX_PARAMS] = {0};
+    b->law = law;
+    for (size_t p = 0; p < law->n_params; ++p) {
+        const bk_param *param = &law->params[p];
+        entry *e = lookup(ld, section, param->key);
+        if (!e && inherit)
+            e = lookup(ld, "friction", param->key);
+        origin[p] = e;
+        if (e) {
+            b->friction_params[p] = e->number;
+        } else if (param->flags & BK_PARAM_REQUIRED) {
+            report_missing(ld, e || !own_law ? "friction" : param_section, param, NULL);
+            b->friction_params[p] = NAN;
+        } else {
+            b->friction_params[p] = param->default_value;
+        }
+    }
+    if (law->complete) {
+        bk_friction_context ctx = {fabs(driver_speed), b->normal_force};
+        law->complete(b->friction_params, &ctx);
+    }
+    if (law->validate) {
+        char msg[256];
+        int bad = law->validate(b->friction_params, msg, sizeof msg);
+        if (bad >= 0) {
+            entry *at = origin[bad];
+            if (at)
+                report_entry(ld, at, "%s", msg);
+            else
+                report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [%s] %s: %s", ld->name, param_section,
+                       law->params[bad].key, msg);
+        }
+    }
+}
+
+static char *default_output_path(const char *name)
+{
+    const char *base = strrchr(name, '/');
+    base = base ? base + 1 : name;
+    size_t len = strlen(base);
+    if (len > 4 && strcmp(base + len - 4, ".ini") == 0)
+        len -= 4;
+    char *path = malloc(len + 4);
+    if (path)
+        snprintf(path, len + 4, "%.*s.h5", (int)len, base);
+    return path;
+}
+
+/* Everything checked: build the config.  Reports missing and cross-key errors. */
+static bk_config *build(loader *ld)
+{
+    bk_config *c = calloc(1, sizeof *c);
+    if (!c)
+        return NULL;
+    double n_value = value_of(ld, "model", "n_blocks");
+    if (!(n_value >= 1))
+        return c; /* reported */
+    size_t n = (size_t)n_value;
+    bk_model *m = bk_model_create(n);
+    if (!m) {
+        report(ld, 0, BK_ERR_NOMEM, "%s: out of memory for %zu blocks", ld->name, n);
+        return c;
+    }
+    c->model = m;
+    m->boundary = (bk_boundary)(int)value_of(ld, "model", "boundary");
+    m->coupling_stiffness = value_of(ld, "model", "coupling_stiffness");
+    m->gravity = value_of(ld, "model", "gravity");
+    m->spring = (bk_spring)(int)value_of(ld, "driver", "spring");
+    m->driver.velocity = value_of(ld, "driver", "velocity");
+    m->driver.start_position = value_of(ld, "driver", "start_position");
+
+    static const char *const required[] = {"mass", "driver_stiffness"};
+    for (size_t i = 0; i < n; ++i) {
+        bk_block *b = &m->blocks[i];
+        int given;
+        for (size_t r = 0; r < 2; ++r) {
+            double value = block_value(ld, i, required[r], &given);
+            if (!given)
+                report_missing(ld, "block", &find_key("block", required[r])->param, find_key("block", required[r]));
+            if (r == 0)
+                b->mass = value;
+            else
+                b->driver_stiffness = value;
+        }
+        b->normal_force = block_value(ld, i, "normal_force", &given);
+        if (!given)
+            b->normal_force = b->mass * m->gravity;
+        b->x_init = block_value(ld, i, "x_init", &given);
+        b->v_init = block_value(ld, i, "v_init", &given);
+        build_friction(ld, b, i, m->driver.velocity);
+        if (ld->error_rank != LONG_MAX && ld->error_rank >= RANK_MISSING)
+            break; /* one missing key is enough; don't repeat it for every block */
+    }
+    bk_model_finalize(m);
+
+    bk_solver_options *s = &c->solver;
+    snprintf(s->method, sizeof s->method, "%s", method_name((size_t)value_of(ld, "solver", "method")));
+    snprintf(s->linear_solver, sizeof s->linear_solver, "%s",
+             linear_solver_names[(size_t)value_of(ld, "solver", "linear_solver")]);
+    s->rtol = value_of(ld, "solver", "rtol");
+    s->atol_x = value_of(ld, "solver", "atol_x");
+    s->atol_v = value_of(ld, "solver", "atol_v");
+    s->max_step = value_of(ld, "solver", "max_step");
+    s->max_steps = (long)value_of(ld, "solver", "max_steps");
+    s->detect_velocity_extrema = (int)value_of(ld, "solver", "detect_velocity_extrema");
+    s->max_transitions_per_instant = (long)value_of(ld, "solver", "max_transitions_per_instant");
+    s->instant_window = value_of(ld, "solver", "instant_window");
+
+    c->t_end = value_of(ld, "run", "t_end");
+    bk_output_options *o = &c->output;
+    entry *path = lookup(ld, "output", "path");
+    o->path = path ? strdup(path->value) : default_output_path(ld->name);
+    if (!o->path)
+        report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+    entry *interval = lookup(ld, "output", "interval");
+    o->interval = interval ? interval->number : c->t_end / 1000.0;
+    if (interval && isfinite(c->t_end) && interval->number > c->t_end)
+        report_entry(ld, interval, "must be <= t_end (%g s), got %s", c->t_end, interval->value);
+    o->fields = (unsigned)value_of(ld, "output", "fields");
+    o->transitions = (int)value_of(ld, "output", "transitions");
+    o->event_rows = (int)value_of(ld, "output", "event_rows");
+    return c;
+}
+
+/* --- public ----------------------------------------------------------------------------- */
+
+void bk_config_free(bk_config *config)
+{
+    if (!config)
+        return;
+    bk_model_free(config->model);
+    free(config->output.path);
+    free(config->source_name);
+    free(config->text);
+    free(config);
+}
+
+static void free_loader(loader *ld)
+{
+    for (size_t i = 0; i < ld->n; ++i)
+        free(ld->entries[i].value);
+    free(ld->entries);
+}
+
+/* Strip surrounding whitespace in place. */
+static void trim(char *s)
+{
+    size_t len = strlen(s), start = 0;
+    while (len > 0 && isspace((unsigned char)s[len - 1]))
+        s[--len] = '\0';
+    while (isspace((unsigned char)s[start]))
+        ++start;
+    memmove(s, s + start, len - start + 1);
+}
+
+/* Append "section.key=value" overrides; malformed ones are reported. */
+static void add_overrides(loader *ld, const char *const *overrides, size_t n_overrides)
+{
+    for (size_t k = 0; k < n_overrides; ++k) {
+        const char *text = overrides[k];
+        long rank = (long)INT_MAX + (long)k;
+        const char *eq = strchr(text, '=');
+        const char *dot = eq ? text : NULL;
+        for (const char *p = text; eq && p < eq; ++p)
+            if (*p == '.')
+                dot = p;
+        if (!eq || dot == text || dot + 1 >= eq || (size_t)(dot - text) >= SECTION_LEN ||
+            (size_t)(eq - dot - 1) >= KEY_LEN) {
+            report(ld, rank, BK_ERR_CONFIG,
+                   "--set %s: expected section.key=value (e.g. block.mass=2 or block.3.mass=2)", text);
+            continue;
+        }
+        char section[SECTION_LEN], key[KEY_LEN];
+        snprintf(section, sizeof section, "%.*s", (int)(dot - text), text);
+        snprintf(key, sizeof key, "%.*s", (int)(eq - dot - 1), dot + 1);
+        trim(section);
+        trim(key);
+        const char *value = eq + 1;
+        while (isspace((unsigned char)*value))
+            ++value;
+        for (size_t i = 0; i < ld->n; ++i)
+            if (strcmp(ld->entries[i].section, section) == 0 && strcmp(ld->entries[i].key, key) == 0)
+                ld->entries[i].superseded = 1;
+        if (add_entry(ld, section, key, value, 0, text, rank) != 0)
+            ld->oom = 1;
+    }
+}
+
+static char *config_text(const char *text, const char *const *overrides, size_t n_overrides)
+{
+    size_t len = strlen(text) + 2;
+    for (size_t k = 0; k < n_overrides; ++k)
+        len += strlen(overrides[k]) + 10;
+    char *out = malloc(len);
+    if (!out)
+        return NULL;
+    size_t used = (size_t)snprintf(out, len, "%s", text);
+    if (used > 0 && out[used - 1] != '\n' && n_overrides)
+        used += (size_t)snprintf(out + used, len - used, "\n");
+    for (size_t k = 0; k < n_overrides; ++k)
+        used += (size_t)snprintf(out + used, len - used, "; --set %s\n", overrides[k]);
+    return out;
+}
+
+int bk_config_load_string(const char *text, const char *name, const char *const *overrides,
+                          size_t n_overrides, bk_config **out, bk_error *err)
+{
+    *out = NULL;
+    loader ld = {.name = name, .error_rank = LONG_MAX, .err = err, .status = BK_OK, .text = text,
+                 .cursor = text};
+    int first_bad = ini_parse_stream(read_line, &ld, on_pair, &ld);
+    if (first_bad > 0)
+        report(&ld, first_bad, BK_ERR_CONFIG,
+               "%s:%d: syntax error: expected \"[section]\", \"key = value\" or a comment", name, first_bad);
+    add_overrides(&ld, overrides, n_overrides);
+    if (ld.oom || first_bad < 0) {
+        free_loader(&ld);
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory while parsing", name);
+    }
+    /* n_blocks first: block indices are checked against it. */
+    entry *n_entry = lookup(&ld, "model", "n_blocks");
+    long n_blocks = 0;
+    if (n_entry && check_value(&ld, n_entry, find_key("model", "n_blocks"), &find_key("model", "n_blocks")->param) == 0)
+        n_blocks = (long)n_entry->number;
+    check_entries(&ld, n_blocks);
+    bk_config *c = NULL;
+    if (ld.error_rank == LONG_MAX)
+        c = build(&ld);
+    if (c && ld.error_rank == LONG_MAX) {
+        c->source_name = strdup(name);
+        c->text = config_text(text, overrides, n_overrides);
+        if (!c->source_name || !c->text)
+            report(&ld, 0, BK_ERR_NOMEM, "%s: out of memory", name);
+    } else if (!c && ld.error_rank == LONG_MAX) {
+        report(&ld, 0, BK_ERR_NOMEM, "%s: out of memory", name);
+    }
+    free_loader(&ld);
+    if (ld.error_rank != LONG_MAX) {
+        bk_config_free(c);
+        return ld.status;
+    }
+    *out = c;
+    return BK_OK;
+}
+
+int bk_config_load_file(const char *path, const char *const *overrides, size_t n_overrides,
+                        bk_config **out, bk_error *err)
+{
+    *out = NULL;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return BK_FAIL(err, BK_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    char *text = malloc(MAX_FILE_BYTES + 1);
+    if (!text) {
+        fclose(f);
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    }
+    size_t len = fread(text, 1, MAX_FILE_BYTES + 1, f);
+    int read_error = ferror(f);
+    fclose(f);
+    int rc;
+    if (read_error)
+        rc = BK_FAIL(err, BK_ERR_IO, "%s: read error", path);
+    else if (len > MAX_FILE_BYTES)
+        rc = BK_FAIL(err, BK_ERR_CONFIG, "%s: larger than %d bytes; not a config file?", path, MAX_FILE_BYTES);
+    else if (memchr(text, '\0', len))
+        rc = BK_FAIL(err, BK_ERR_CONFIG, "%s: contains NUL bytes; not a text file", path);
+    else {
+        text[len] = '\0';
+        rc = bk_config_load_string(text, path, overrides, n_overrides, out, err);
+    }
+    free(text);
+    return rc;
+}
+
+/* --- reference -------------------------------------------------------------------------- */
+
+static void write_default(FILE *out, const key_def *def, const bk_param *param)
+{
+    if (def && def->default_text)
+        fprintf(out, "%s", def->default_text);
+    else if (param->flags & BK_PARAM_REQUIRED)
+        fprintf(out, "required");
+    else if (def && def->type == KEY_BOOL)
+        fprintf(out, "%s", param->default_value != 0 ? "true" : "false");
+    else
+        fprintf(out, "%g", param->default_value);
+}
+
+static void write_row(FILE *out, const key_def *def, const bk_param *param)
+{
+    char allowed[512];
+    format_allowed(def, param, allowed, sizeof allowed);
+    const char *unit = param->unit && param->unit[0] ? param->unit : "-";
+    fprintf(out, "| `%s` | %s | ", param->key, unit);
+    write_default(out, def, param);
+    fprintf(out, " | %s | %s |\n", allowed, param->doc);
+}
+
+void bk_config_write_reference(FILE *out)
+{
+    static const char *const notes[] = {
+        "model", "The chain.",
+        "block", "Defaults for every block; a `[block.I]` section (I = 0 .. n_blocks-1) overrides them for block I.",
+        "friction", "The friction law of every block and its parameters (tables below); `[friction.I]` overrides "
+                    "them for block I. A `[friction.I]` naming a different law takes none of `[friction]`'s parameters.",
+        "driver", "The driver that pulls every block through its driver spring.",
+        "solver", "Integration.",
+        "output", "The HDF5 file.",
+        "run", "The time span.",
+    };
+    fprintf(out, "Units are SI. Keys are case-sensitive; `;` starts a comment (also after a value).\n");
+    for (size_t s = 0; sections[s]; ++s) {
+        fprintf(out, "\n### [%s]\n\n%s\n\n", sections[s], notes[2 * s + 1]);
+        fprintf(out, "| key | unit | default | allowed | meaning |\n| --- | --- | --- | --- | --- |\n");
+        for (size_t i = 0; i < N_KEYS; ++i)
+            if (strcmp(keys[i].section, sections[s]) == 0)
+                write_row(out, &keys[i], &keys[i].param);
+    }
+    for (const bk_friction_law *const *law = bk_friction_laws(); *law; ++law) {
+        fprintf(out, "\n### [friction] law = %s\n\n%s\n\n", (*law)->name, (*law)->doc);
+        fprintf(out, "| key | unit | default | allowed | meaning |\n| --- | --- | --- | --- | --- |\n");
+        for (size_t p = 0; p < (*law)->n_params; ++p)
+            write_row(out, NULL, &(*law)->params[p]);
+    }
+}

@@ -1,0 +1,315 @@
+/* The compact ODE of a chain with per-block modes (layout in scene.h): right-hand side,
+ * root functions, and packing between the chain's arrays and the integrator's vector.
+ *
+ * Root functions, per block (all clearly non-zero right after the block switched, so a
+ * just-handled root cannot fire again after a restart):
+ *   stuck:    g = F_s - |F|                    falls through 0 at breakaway
+ *   slipping: g = s v / (t - t_switch)         falls through 0 at the stop; at t_switch it
+ *             (s v when the slip did not        equals its limit s a > 0 instead of 0
+ *              start from rest)
+ *             g = s a                          rises through 0 at a slip-rate minimum, where
+ *                                              a stop hidden inside one step shows as s v < 0
+ *   tension-only spring: g = D - x             the spring's kink (slack/taut) */
+#include "scene.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NO_SLOT SIZE_MAX
+
+int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
+{
+    memset(scene, 0, sizeof *scene);
+    size_t n = model->n_blocks;
+    scene->model = model;
+    scene->n = n;
+    scene->detect_extrema = detect_extrema;
+    scene->roots_per_block = model->spring == BK_SPRING_TENSION_ONLY ? 3 : 2;
+    scene->mode = calloc(n, sizeof *scene->mode);
+    scene->x_ref = calloc(n, sizeof *scene->x_ref);
+    scene->x = calloc(n, sizeof *scene->x);
+    scene->v = calloc(n, sizeof *scene->v);
+    scene->state = calloc(model->n_friction_state + 1, sizeof *scene->state);
+    scene->normal = calloc(n, sizeof *scene->normal);
+    scene->t_switch = calloc(n, sizeof *scene->t_switch);
+    scene->from_rest = calloc(n, sizeof *scene->from_rest);
+    scene->taut = calloc(n, sizeof *scene->taut);
+    scene->slot = calloc(n, sizeof *scene->slot);
+    scene->state_slot = calloc(n, sizeof *scene->state_slot);
+    scene->active = calloc(n, sizeof *scene->active);
+    scene->stateful = calloc(n, sizeof *scene->stateful);
+    scene->left = calloc(n, sizeof *scene->left);
+    scene->right = calloc(n, sizeof *scene->right);
+    scene->root_direction = calloc(n * scene->roots_per_block, sizeof *scene->root_direction);
+    if (!scene->mode || !scene->x_ref || !scene->x || !scene->v || !scene->state ||
+        !scene->normal || !scene->t_switch || !scene->from_rest || !scene->taut || !scene->slot ||
+        !scene->state_slot || !scene->active || !scene->stateful || !scene->left ||
+        !scene->right || !scene->root_direction) {
+        bk_scene_free(scene);
+        return -1;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const bk_block *b = &model->blocks[i];
+        scene->normal[i] = b->normal_force;
+        scene->x[i] = scene->x_ref[i] = b->x_init;
+        scene->v[i] = b->v_init;
+        bk_model_neighbours(model, i, &scene->left[i], &scene->right[i]);
+        if (b->law->n_state > 0) {
+            scene->stateful[scene->n_stateful++] = i;
+            b->law->state_init(b->friction_params, &scene->state[b->state_offset]);
+        }
+    }
+    return 0;
+}
+
+void bk_scene_free(bk_scene *scene)
+{
+    free(scene->mode);
+    free(scene->x_ref);
+    free(scene->x);
+    free(scene->v);
+    free(scene->state);
+    free(scene->normal);
+    free(scene->t_switch);
+    free(scene->from_rest);
+    free(scene->taut);
+    free(scene->slot);
+    free(scene->state_slot);
+    free(scene->active);
+    free(scene->stateful);
+    free(scene->left);
+    free(scene->right);
+    free(scene->root_direction);
+    memset(scene, 0, sizeof *scene);
+}
+
+/* Position of block j given the integrated vector (stuck blocks sit at x_ref). */
+static inline double position(const bk_scene *scene, const double *y, long j)
+{
+    if (j < 0)
+        return 0.0; /* a fixed wall */
+    size_t s = scene->slot[j];
+    return s == NO_SLOT ? scene->x_ref[j] : scene->x_ref[j] + y[s];
+}
+
+/* Driver-spring force with the spring's taut/slack state frozen since the restart. */
+static inline double driver_force(const bk_scene *scene, size_t i, double x_i, double driver_pos)
+{
+    if (scene->model->spring == BK_SPRING_TENSION_ONLY && !scene->taut[i])
+        return 0.0;
+    return scene->model->blocks[i].driver_stiffness * (driver_pos - x_i);
+}
+
+static inline double coupling_force(const bk_scene *scene, const double *y, size_t i, double x_i)
+{
+    double kc = scene->model->coupling_stiffness;
+    if (kc == 0.0)
+        return 0.0;
+    double force = 0.0;
+    if (scene->left[i] != -1)
+        force += kc * (position(scene, y, scene->left[i]) - x_i);
+    if (scene->right[i] != -1)
+        force += kc * (position(scene, y, scene->right[i]) - x_i);
+    return force;
+}
+
+static inline const double *block_state(const bk_scene *scene, const double *y, size_t i)
+{
+    const bk_block *b = &scene->model->blocks[i];
+    if (b->law->n_state == 0)
+        return NULL;
+    return y ? &y[scene->state_slot[i]] : &scene->state[b->state_offset];
+}
+
+void bk_scene_restart(bk_scene *scene, double t, double *y)
+{
+    const bk_model *model = scene->model;
+    size_t n = scene->n, next = 0, R = scene->roots_per_block;
+    size_t max_state = 0;
+    scene->n_active = 0;
+    scene->stuck_taut_stiffness = 0.0;
+    scene->stuck_force_ref = 0.0;
+    double driver_pos = bk_driver_position(&model->driver, t);
+    for (size_t i = 0; i < n; ++i) {
+        const bk_block *b = &model->blocks[i];
+        scene->x_ref[i] = scene->x[i];
+        int dir = bk_mode_direction((bk_mode)scene->mode[i]);
+        double extension = driver_pos - scene->x[i];
+        /* At the kink itself the spring is taut if the driver is pulling away. */
+        scene->taut[i] = model->spring == BK_SPRING_LINEAR || extension > 0.0 ||
+                         (extension == 0.0 &&
+                          bk_driver_velocity(&model->driver, t) - (dir != 0 ? scene->v[i] : 0.0) > 0.0);
+        if (dir != 0) {
+            scene->slot[i] = next;
+            scene->active[scene->n_active++] = i;
+            y[next] = 0.0;
+            y[next + 1] = scene->v[i];
+            next += 2;
+        } else {
+            scene->slot[i] = NO_SLOT;
+            scene->v[i] = 0.0;
+            if (scene->taut[i]) {
+                scene->stuck_taut_stiffness += b->driver_stiffness;
+                scene->stuck_force_ref += b->driver_stiffness * extension;
+            }
+        }
+        size_t ns = b->law->n_state;
+        if (ns > 0) {
+            scene->state_slot[i] = next;
+            memcpy(&y[next], &scene->state[b->state_offset], ns * sizeof *y);
+            next += ns;
+            if (ns > max_state)
+                max_state = ns;
+        }
+        scene->root_direction[R * i + BK_ROOT_MAIN] = -1;
+        scene->root_direction[R * i + BK_ROOT_EXTREMUM] = dir != 0 ? +1 : 0;
+        if (R > 2)
+            scene->root_direction[R * i + BK_ROOT_SLACK] = 0;
+    }
+    y[next] = 0.0;     /* driver work since t */
+    y[next + 1] = 0.0; /* dissipation since t */
+    scene->n_y = next + 2;
+    scene->half_bandwidth = 3 + max_state;
+    scene->t_ref = t;
+    scene->work_ref = scene->work;
+    scene->dissipation_ref = scene->dissipation;
+}
+
+void bk_scene_tolerances(const bk_scene *scene, double atol_x, double atol_v, double atol_state,
+                         double atol_energy, double *atol)
+{
+    for (size_t k = 0; k < scene->n_active; ++k) {
+        size_t s = scene->slot[scene->active[k]];
+        atol[s] = atol_x;
+        atol[s + 1] = atol_v;
+    }
+    for (size_t k = 0; k < scene->n_stateful; ++k) {
+        size_t i = scene->stateful[k];
+        for (size_t j = 0; j < scene->model->blocks[i].law->n_state; ++j)
+            atol[scene->state_slot[i] + j] = atol_state;
+    }
+    atol[scene->n_y - 2] = atol_energy;
+    atol[scene->n_y - 1] = atol_energy;
+}
+
+void bk_scene_unpack(bk_scene *scene, double t, const double *y)
+{
+    (void)t;
+    const bk_model *model = scene->model;
+    for (size_t i = 0; i < scene->n; ++i) {
+        size_t s = scene->slot[i];
+        if (s == NO_SLOT) {
+            scene->x[i] = scene->x_ref[i];
+            scene->v[i] = 0.0;
+        } else {
+            scene->x[i] = scene->x_ref[i] + y[s];
+            scene->v[i] = y[s + 1];
+        }
+    }
+    for (size_t k = 0; k < scene->n_stateful; ++k) {
+        size_t i = scene->stateful[k];
+        const bk_block *b = &model->blocks[i];
+        memcpy(&scene->state[b->state_offset], &y[scene->state_slot[i]],
+               b->law->n_state * sizeof *y);
+    }
+    scene->work = scene->work_ref + y[scene->n_y - 2];
+    scene->dissipation = scene->dissipation_ref + y[scene->n_y - 1];
+}
+
+int bk_scene_rhs(double t, const double *y, double *ydot, void *user)
+{
+    const bk_scene *scene = user;
+    const bk_model *model = scene->model;
+    double driver_pos = bk_driver_position(&model->driver, t);
+    double driver_disp = bk_driver_displacement(&model->driver, scene->t_ref, t);
+    double driver_force_sum = scene->stuck_force_ref + scene->stuck_taut_stiffness * driver_disp;
+    double dissipation_rate = 0.0;
+    for (size_t k = 0; k < scene->n_active; ++k) {
+        size_t i = scene->active[k], s = scene->slot[i];
+        const bk_block *b = &model->blocks[i];
+        double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
+        double dir = (double)scene->mode[i];
+        double spring = driver_force(scene, i, x_i, driver_pos);
+        double applied = spring + coupling_force(scene, y, i, x_i);
+        double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
+                                                block_state(scene, y, i));
+        ydot[s] = v_i;
+        ydot[s + 1] = (applied - dir * friction) / b->mass;
+        driver_force_sum += spring;
+        dissipation_rate += dir * friction * v_i;
+    }
+    for (size_t k = 0; k < scene->n_stateful; ++k) {
+        size_t i = scene->stateful[k];
+        const bk_block *b = &model->blocks[i];
+        size_t s = scene->slot[i];
+        double speed = s == NO_SLOT ? 0.0 : fabs(y[s + 1]);
+        b->law->state_rate(b->friction_params, speed, &y[scene->state_slot[i]],
+                           &ydot[scene->state_slot[i]]);
+    }
+    ydot[scene->n_y - 2] = bk_driver_velocity(&model->driver, t) * driver_force_sum;
+    ydot[scene->n_y - 1] = dissipation_rate;
+    return 0;
+}
+
+int bk_scene_roots(double t, const double *y, double *g, void *user)
+{
+    const bk_scene *scene = user;
+    const bk_model *model = scene->model;
+    size_t R = scene->roots_per_block;
+    double driver_pos = bk_driver_position(&model->driver, t);
+    for (size_t i = 0; i < scene->n; ++i) {
+        const bk_block *b = &model->blocks[i];
+        double *gi = &g[R * i];
+        double x_i = position(scene, y, (long)i);
+        double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(scene, y, i, x_i);
+        const double *state = block_state(scene, y, i);
+        size_t s = scene->slot[i];
+        if (s == NO_SLOT) {
+            gi[BK_ROOT_MAIN] = b->law->static_threshold(b->friction_params, scene->normal[i], state) -
+                               fabs(applied);
+            gi[BK_ROOT_EXTREMUM] = 1.0;
+        } else {
+            double dir = (double)scene->mode[i];
+            double v_i = y[s + 1];
+            double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i, state);
+            double slip_accel = dir * (applied - dir * friction) / b->mass;
+            double since = t - scene->t_switch[i];
+            if (!scene->from_rest[i])
+                gi[BK_ROOT_MAIN] = dir * v_i;
+            else
+                gi[BK_ROOT_MAIN] = since > 0.0 ? dir * v_i / since : slip_accel;
+            gi[BK_ROOT_EXTREMUM] = scene->detect_extrema ? slip_accel : 1.0;
+        }
+        if (R > 2)
+            gi[BK_ROOT_SLACK] = driver_pos - x_i;
+    }
+    return 0;
+}
+
+double bk_scene_applied_force(const bk_scene *scene, size_t i, double driver_pos)
+{
+    return bk_model_applied_force(scene->model, i, scene->x, driver_pos);
+}
+
+double bk_scene_static_threshold(const bk_scene *scene, size_t i)
+{
+    const bk_block *b = &scene->model->blocks[i];
+    return b->law->static_threshold(b->friction_params, scene->normal[i], block_state(scene, NULL, i));
+}
+
+double bk_scene_sliding_force(const bk_scene *scene, size_t i, double slip_rate)
+{
+    const bk_block *b = &scene->model->blocks[i];
+    return b->law->sliding_force(b->friction_params, scene->normal[i], slip_rate,
+                                 block_state(scene, NULL, i));
+}
+
+double bk_scene_friction(const bk_scene *scene, size_t i, double driver_pos)
+{
+    int dir = bk_mode_direction((bk_mode)scene->mode[i]);
+    if (dir == 0)
+        return bk_scene_applied_force(scene, i, driver_pos);
+    return dir * bk_scene_sliding_force(scene, i, dir * scene->v[i]);
+}

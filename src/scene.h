@@ -1,0 +1,88 @@
+/* Internal: the chain's state during a run and the compact ODE the integrator sees.
+ *
+ * Only slipping blocks carry dynamics.  Between two (re)starts the integrated vector is,
+ * in chain order, per block: [xi, v] if slipping (xi = x - x_ref, the slip since the
+ * restart, so the integrator's error scales with the slip, not the absolute position),
+ * then the block's friction state if its law has any; and last two energy increments since
+ * the restart: driver work and frictional dissipation.  Stuck blocks keep x = x_ref, v = 0. */
+#ifndef BKSIM_SCENE_H
+#define BKSIM_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "bksim/model.h"
+#include "bksim/modes.h"
+
+/* Root slots per block: 0 = breakaway (stuck) or stop (slipping), 1 = slip-rate minimum,
+ * 2 = driver spring going slack/taut (tension-only springs only). */
+enum { BK_ROOT_MAIN = 0, BK_ROOT_EXTREMUM = 1, BK_ROOT_SLACK = 2 };
+
+typedef struct bk_scene {
+    const bk_model *model;
+    size_t n;                /* blocks */
+    int8_t *mode;            /* bk_mode per block */
+    double *x_ref;           /* m, positions at the last restart (stuck blocks: their position) */
+    double *x;               /* m, current positions (unpacked) */
+    double *v;               /* m/s, current velocities (unpacked) */
+    double *state;           /* friction states, model->n_friction_state */
+    double *normal;          /* N, per block */
+    double *t_switch;        /* s, when each block last started slipping from rest */
+    uint8_t *from_rest;      /* 1 when the current slip started at zero velocity at t_switch */
+    uint8_t *taut;           /* tension-only springs: 1 while the spring pulls.  Held fixed
+                                between restarts, like the slip direction, so the right-hand
+                                side stays smooth and the slack root is located on a smooth
+                                solution; the restart at that root flips it. */
+    int detect_extrema;      /* arm the slip-rate minimum roots */
+
+    /* Compact layout, rebuilt at every restart. */
+    size_t *slot;            /* per block: index of xi in y, or SIZE_MAX when stuck */
+    size_t *state_slot;      /* per block: index of its first friction state in y */
+    size_t n_y;              /* length of y */
+    size_t n_active;         /* slipping blocks */
+    size_t half_bandwidth;   /* Jacobian half bandwidth of the layout */
+    double t_ref;            /* s, time of the last restart */
+    double work_ref;         /* J, driver work up to t_ref */
+    double dissipation_ref;  /* J, dissipation up to t_ref */
+    double stuck_taut_stiffness; /* N/m, sum of k_i over stuck blocks with a taut driver spring */
+    double stuck_force_ref;      /* N, their driver-spring forces at t_ref */
+    size_t *active;          /* the n_active slipping blocks, chain order */
+    size_t *stateful;        /* blocks whose law carries state */
+    size_t n_stateful;
+    long *left, *right;      /* coupling partners (bk_model_neighbours) */
+
+    /* Unpacked energies at the current time. */
+    double work;             /* J */
+    double dissipation;      /* J */
+
+    size_t roots_per_block;  /* 2, or 3 with tension-only springs */
+    int *root_direction;     /* n * roots_per_block */
+} bk_scene;
+
+int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema);
+void bk_scene_free(bk_scene *scene);
+
+/* Rebuild the layout for the current modes at time t (x, v, state, work, dissipation hold
+ * the state there) and write the integrator's starting vector into y (size n_y). */
+void bk_scene_restart(bk_scene *scene, double t, double *y);
+/* Per-component absolute tolerances for the current layout. */
+void bk_scene_tolerances(const bk_scene *scene, double atol_x, double atol_v, double atol_state,
+                         double atol_energy, double *atol);
+/* Fill x, v, state, work, dissipation from the integrated vector y at time t. */
+void bk_scene_unpack(bk_scene *scene, double t, const double *y);
+
+/* The ODE right-hand side and root functions for the current layout (bk_ode_problem). */
+int bk_scene_rhs(double t, const double *y, double *ydot, void *scene);
+int bk_scene_roots(double t, const double *y, double *g, void *scene);
+
+/* Applied (spring) force on block i with the unpacked positions at driver position D. */
+double bk_scene_applied_force(const bk_scene *scene, size_t i, double driver_pos);
+/* Static threshold of block i (N) with its current friction state; +inf-free. */
+double bk_scene_static_threshold(const bk_scene *scene, size_t i);
+/* Sliding force magnitude of block i at slip rate s*v (N). */
+double bk_scene_sliding_force(const bk_scene *scene, size_t i, double slip_rate);
+/* Shear force the interface carries at block i (N, positive when it resists +x motion):
+ * the applied force when stuck, s * sliding force when slipping. */
+double bk_scene_friction(const bk_scene *scene, size_t i, double driver_pos);
+
+#endif

@@ -1,0 +1,351 @@
+/* The bksim command line end to end, as a user and a batch script meet it: the paper's
+ * configs give the closed-form transitions in the HDF5 file; every bad input gives a
+ * clear message, exit status 2 and no output file. Runs ./bksim from the repository root. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "bk_test.h"
+#include "bksim/bksim.h"
+#include "exact_single.h"
+
+static char tmpdir[256];
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/bksim_cli_XXXXXX");
+    return mkdtemp(tmpdir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+/* Run a shell command; return its exit status, with stdout+stderr in *output (malloc'ed). */
+static int run(const char *command, char **output)
+{
+    char full[4096];
+    snprintf(full, sizeof full, "{ %s; } 2>&1", command);
+    FILE *p = popen(full, "r");
+    assert_non_null(p);
+    size_t cap = 4096, len = 0;
+    char *buf = malloc(cap);
+    assert_non_null(buf);
+    size_t got;
+    while ((got = fread(buf + len, 1, cap - len - 1, p)) > 0) {
+        len += got;
+        if (cap - len < 2) {
+            cap *= 2;
+            buf = realloc(buf, cap);
+            assert_non_null(buf);
+        }
+    }
+    buf[len] = '\0';
+    int status = pclose(p);
+    if (output)
+        *output = buf;
+    else
+        free(buf);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static int exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+/* --- the paper's configs --------------------------------------------------------------- */
+
+static void check_paper_case(const char *stem, double mu_d, int tension_only)
+{
+    char out[512], cmd[1024];
+    snprintf(out, sizeof out, "%s/%s.h5", tmpdir, stem);
+    snprintf(cmd, sizeof cmd, "./bksim run configs/paper/%s.ini -o %s --quiet", stem, out);
+    char *text = NULL;
+    int status = run(cmd, &text);
+    if (status != 0)
+        print_error("%s\n", text);
+    free(text);
+    assert_int_equal(status, 0);
+    assert_true(exists(out));
+
+    bk_transition *rows = NULL;
+    size_t n = 0;
+    bk_error err = {0};
+    assert_int_equal(bk_h5_read_transitions(out, &rows, &n, &err), BK_OK);
+    exact_params p = {1.0, 1e4, 9.81, 0.6, mu_d, 1e-3, tension_only};
+    exact_solution ex;
+    assert_int_equal(exact_solve(&p, 5.0, &ex), 0);
+    assert_int_equal(n, ex.n_events);
+    /* First slip at t = 0.5886 s; every transition's time and position to 1e-8. */
+    assert_close(rows[0].t, 0.5886, 1e-12, 0.0);
+    double worst = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+        assert_int_equal(rows[k].from, ex.events[k].from);
+        assert_int_equal(rows[k].to, ex.events[k].to);
+        assert_close(rows[k].t, ex.events[k].t, 1e-8, 0.0);
+        assert_close(rows[k].x, ex.events[k].x, 1e-8, 1e-15);
+        double rel = fabs(rows[k].t - ex.events[k].t) / ex.events[k].t;
+        worst = rel > worst ? rel : worst;
+    }
+    print_message("%s: %zu transitions, worst relative time error %.2g\n", stem, n, worst);
+    if (mu_d == 0.1 && !tension_only) /* case A's first slip lasts 31.82 ms */
+        assert_close(rows[1].t - rows[0].t, 31.82e-3, 2e-4, 0.0);
+
+    /* The time series: rows at 0.1 ms plus one per transition instant. */
+    double *time = NULL;
+    size_t t_rows, cols;
+    assert_int_equal(bk_h5_read_doubles(out, "/time", &time, &t_rows, &cols, &err), BK_OK);
+    assert_close(time[t_rows - 1], 5.0, 0, 0);
+    assert_true(t_rows >= 50001);
+    free(time);
+    free(rows);
+    exact_free(&ex);
+}
+
+static void test_paper_configs(void **state)
+{
+    (void)state;
+    check_paper_case("case_a_coulomb", 0.1, 0);
+    check_paper_case("case_b_coulomb", 0.5, 0);
+    check_paper_case("case_c_coulomb", 0.5999, 0);
+    check_paper_case("case_a_coulomb_tension_only", 0.1, 1);
+    check_paper_case("case_b_coulomb_tension_only", 0.5, 1);
+    check_paper_case("case_c_coulomb_tension_only", 0.5999, 1);
+}
+
+/* --- bad input: clear message, exit 2, no file ----------------------------------------- */
+
+static const char *const good_config =
+    "[model]\n"
+    "n_blocks = 1\n"
+    "[block]\n"
+    "mass = 1\n"
+    "driver_stiffness = 1e4\n"
+    "[friction]\n"
+    "law = coulomb\n"
+    "mu_s = 0.6\n"
+    "mu_d = 0.5\n"
+    "[driver]\n"
+    "velocity = 1e-3\n"
+    "[run]\n"
+    "t_end = 0.7\n";
+
+/* Write good_config with `line` replaced by `replacement` (NULL: dropped). */
+static void write_config(const char *path, const char *line, const char *replacement)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    const char *p = good_config;
+    while (*p) {
+        const char *eol = strchr(p, '\n');
+        size_t len = (size_t)(eol - p);
+        if (line && strlen(line) == len && strncmp(p, line, len) == 0) {
+            if (replacement)
+                fprintf(f, "%s\n", replacement);
+        } else {
+            fprintf(f, "%.*s\n", (int)len, p);
+        }
+        p = eol + 1;
+    }
+    fclose(f);
+}
+
+typedef struct bad_case {
+    const char *line, *replacement;
+    const char *expect; /* substring of the message */
+} bad_case;
+
+static void test_bad_inputs(void **state)
+{
+    (void)state;
+    const bad_case cases[] = {
+        {"mass = 1", "mass = 0", "bad.ini:4: [block] mass:"},
+        {"mass = 1", "mass = -2", "bad.ini:4: [block] mass:"},
+        {"mass = 1", "mass = nan", "bad.ini:4: [block] mass:"},
+        {"mass = 1", "mass = 1 # kg", "bad.ini:4: [block] mass:"},
+        {"mass = 1", NULL, "bad.ini: [block] mass: required key missing"},
+        {"mu_d = 0.5", "mu_d = 0.7", "bad.ini:9: [friction] mu_d: must be <= mu_s (0.6), got 0.7"},
+        {"driver_stiffness = 1e4", "driver_stiffness = -1e4", "bad.ini:5: [block] driver_stiffness:"},
+        {"t_end = 0.7", "t_end = 0", "bad.ini:13: [run] t_end:"},
+        {"t_end = 0.7", "t_end = -1", "bad.ini:13: [run] t_end:"},
+        {"t_end = 0.7", NULL, "bad.ini: [run] t_end: required key missing"},
+        {"velocity = 1e-3", "velocity = 1e-3\nspeed = 2", "bad.ini:12: [driver] speed:"},
+        {"law = coulomb", "law = magic", "bad.ini:7: [friction] law:"},
+        {"[model]", "[modle]", "bad.ini:1:"},
+    };
+    char path[512], out[512], cmd[2048], cwd[1024];
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    snprintf(path, sizeof path, "%s/bad.ini", tmpdir);
+    snprintf(out, sizeof out, "%s/never.h5", tmpdir);
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        write_config(path, cases[k].line, cases[k].replacement);
+        snprintf(cmd, sizeof cmd, "cd %s && %s/bksim run bad.ini -o %s", tmpdir, cwd, out);
+        char *text = NULL;
+        int status = run(cmd, &text);
+        if (status != 2 || !strstr(text, cases[k].expect))
+            print_error("case %zu: status %d, output:\n%s\nexpected: %s\n", k, status, text,
+                        cases[k].expect);
+        assert_int_equal(status, 2);
+        assert_non_null(strstr(text, cases[k].expect));
+        assert_false(exists(out));
+        char part[600];
+        snprintf(part, sizeof part, "%s.part", out);
+        assert_false(exists(part));
+        free(text);
+        /* check says the same */
+        snprintf(cmd, sizeof cmd, "cd %s && %s/bksim check bad.ini", tmpdir, cwd);
+        assert_int_equal(run(cmd, NULL), 2);
+    }
+    /* An unreadable config: I/O failure, exit 1, nothing written. */
+    snprintf(cmd, sizeof cmd, "./bksim run %s/missing.ini -o %s", tmpdir, out);
+    char *text = NULL;
+    assert_int_equal(run(cmd, &text), 1);
+    assert_non_null(strstr(text, "missing.ini"));
+    assert_false(exists(out));
+    free(text);
+    /* A bad --set names itself as the location. */
+    write_config(path, NULL, NULL);
+    snprintf(cmd, sizeof cmd, "./bksim run %s --set block.mass=0 -o %s", path, out);
+    assert_int_equal(run(cmd, &text), 2);
+    assert_non_null(strstr(text, "--set block.mass=0: [block] mass:"));
+    assert_false(exists(out));
+    free(text);
+}
+
+/* --- the other commands ---------------------------------------------------------------- */
+
+static void test_commands(void **state)
+{
+    (void)state;
+    char path[512], out[512], cmd[2048];
+    char *text = NULL;
+    snprintf(path, sizeof path, "%s/good.ini", tmpdir);
+    snprintf(out, sizeof out, "%s/good.h5", tmpdir);
+    write_config(path, NULL, NULL);
+
+    snprintf(cmd, sizeof cmd, "./bksim check %s", path);
+    assert_int_equal(run(cmd, &text), 0);
+    assert_non_null(strstr(text, "ok"));
+    free(text);
+
+    /* --set changes the run: a shorter t_end. */
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --set run.t_end=0.65 --quiet", path, out);
+    assert_int_equal(run(cmd, NULL), 0);
+    assert_true(exists(out));
+    double *time = NULL;
+    size_t rows, cols;
+    bk_error err = {0};
+    assert_int_equal(bk_h5_read_doubles(out, "/time", &time, &rows, &cols, &err), BK_OK);
+    assert_close(time[rows - 1], 0.65, 0, 0);
+    free(time);
+
+    snprintf(cmd, sizeof cmd, "./bksim info %s", out);
+    assert_int_equal(run(cmd, &text), 0);
+    assert_non_null(strstr(text, "t_end"));
+    assert_non_null(strstr(text, "--set run.t_end=0.65")); /* the config as run */
+    free(text);
+
+    snprintf(cmd, sizeof cmd, "./bksim export %s --datasets time,x,v --block 0", out);
+    assert_int_equal(run(cmd, &text), 0);
+    assert_true(text[0] == '#');
+    free(text);
+    snprintf(cmd, sizeof cmd, "./bksim export %s --transitions", out);
+    assert_int_equal(run(cmd, &text), 0);
+    assert_non_null(strstr(text, "0.5886"));
+    free(text);
+    snprintf(cmd, sizeof cmd, "./bksim export %s --block 7", out);
+    assert_int_equal(run(cmd, NULL), 1);
+    snprintf(cmd, sizeof cmd, "./bksim info %s/nothing.h5", tmpdir);
+    assert_int_equal(run(cmd, NULL), 1);
+
+    const char *helps[] = {"run", "check", "info", "export", "keys"};
+    for (size_t k = 0; k < 5; ++k) {
+        snprintf(cmd, sizeof cmd, "./bksim %s --help", helps[k]);
+        assert_int_equal(run(cmd, &text), 0);
+        assert_non_null(strstr(text, "usage: bksim"));
+        free(text);
+    }
+    assert_int_equal(run("./bksim frobnicate", NULL), 2);
+    assert_int_equal(run("./bksim", NULL), 2);
+    assert_int_equal(run("./bksim run", NULL), 2);
+    assert_int_equal(run("./bksim --version", &text), 0);
+    assert_non_null(strstr(text, BKSIM_VERSION));
+    free(text);
+    assert_int_equal(run("./bksim keys", &text), 0);
+    assert_non_null(strstr(text, "mu_d"));
+    free(text);
+}
+
+/* SIGTERM mid-run: the run stops, the file stays "<out>.part" marked incomplete. */
+static void test_interrupted_run_is_marked(void **state)
+{
+    (void)state;
+    char out[512], cmd[2048];
+    snprintf(out, sizeof out, "%s/long.h5", tmpdir);
+    snprintf(cmd, sizeof cmd,
+             "./bksim run configs/paper/case_c_coulomb.ini -o %s --quiet "
+             "--set run.t_end=100000 --set output.interval=1e-3 & pid=$!; sleep 1; "
+             "kill -TERM $pid; wait $pid",
+             out);
+    char *text = NULL;
+    int status = run(cmd, &text);
+    assert_int_equal(status, 1);
+    assert_non_null(strstr(text, "interrupted"));
+    free(text);
+    assert_false(exists(out));
+    char part[600];
+    snprintf(part, sizeof part, "%s.part", out);
+    assert_true(exists(part));
+    snprintf(cmd, sizeof cmd, "./bksim info %s", part);
+    assert_int_equal(run(cmd, &text), 0);
+    assert_non_null(strstr(text, "complete"));
+    free(text);
+}
+
+/* README's config reference is exactly what `bksim keys` prints. */
+static void test_readme_reference_current(void **state)
+{
+    (void)state;
+    char *keys = NULL;
+    assert_int_equal(run("./bksim keys", &keys), 0);
+    FILE *f = fopen("README.md", "r");
+    assert_non_null(f);
+    char *readme = calloc(1, 1 << 20);
+    assert_non_null(readme);
+    size_t len = fread(readme, 1, (1 << 20) - 1, f);
+    fclose(f);
+    readme[len] = '\0';
+    const char *begin = strstr(readme, "<!-- keys:begin -->\n");
+    const char *end = strstr(readme, "<!-- keys:end -->");
+    assert_non_null(begin);
+    assert_non_null(end);
+    begin += strlen("<!-- keys:begin -->\n");
+    if ((size_t)(end - begin) != strlen(keys) || strncmp(begin, keys, strlen(keys)) != 0)
+        print_error("README.md's config reference is stale: run scripts/update_readme_keys.sh\n");
+    assert_int_equal((size_t)(end - begin), strlen(keys));
+    assert_int_equal(strncmp(begin, keys, strlen(keys)), 0);
+    free(readme);
+    free(keys);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_paper_configs),
+        cmocka_unit_test(test_bad_inputs),
+        cmocka_unit_test(test_commands),
+        cmocka_unit_test(test_interrupted_run_is_marked),
+        cmocka_unit_test(test_readme_reference_current),
+    };
+    return cmocka_run_group_tests_name("cli", tests, setup, teardown);
+}

@@ -1,0 +1,386 @@
+/* The config loader: every value lands where it should, defaults apply, every rejection
+ * path gives its exact message, and every shipped config loads. */
+#define _POSIX_C_SOURCE 200809L
+#include <glob.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "bk_test.h"
+#include "bksim/config.h"
+
+static const char *const full_config =
+    "; a full config\n"
+    "[model]\n"
+    "n_blocks = 3\n"
+    "boundary = fixed\n"
+    "coupling_stiffness = 2.385e3\n"
+    "gravity = 9.8\n"
+    "[block]\n"
+    "mass = 1.5\n"
+    "driver_stiffness = 1e4\n"
+    "x_init = 1e-6\n"
+    "[block.1]\n"
+    "mass = 2.5\n"
+    "normal_force = 30\n"
+    "v_init = -0.01\n"
+    "[friction]\n"
+    "law = coulomb\n"
+    "mu_s = 0.6\n"
+    "mu_d = 0.5\n"
+    "[friction.2]\n"
+    "mu_d = 0.4\n"
+    "[driver]\n"
+    "velocity = 2e-3\n"
+    "spring = tension_only\n"
+    "start_position = 1e-4\n"
+    "[solver]\n"
+    "method = cvode_bdf\n"
+    "linear_solver = band\n"
+    "rtol = 1e-9\n"
+    "atol_x = 1e-15\n"
+    "max_steps = 5000\n"
+    "detect_velocity_extrema = no\n"
+    "max_transitions_per_instant = 7\n"
+    "[output]\n"
+    "path = out/x.h5\n"
+    "interval = 0.01\n"
+    "fields = x, v mode\n"
+    "transitions = false\n"
+    "[run]\n"
+    "t_end = 2.5\n";
+
+static const char *const minimal_config =
+    "[model]\nn_blocks = 1\n"
+    "[block]\nmass = 1\ndriver_stiffness = 1e4\n"
+    "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
+    "[driver]\nvelocity = 1e-3\n"
+    "[run]\nt_end = 5\n";
+
+static void test_full_config(void **state)
+{
+    (void)state;
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(full_config, "full.ini", NULL, 0, &c, &err), BK_OK);
+    const bk_model *m = c->model;
+    assert_int_equal(m->n_blocks, 3);
+    assert_int_equal(m->boundary, BK_BOUNDARY_FIXED);
+    assert_close(m->coupling_stiffness, 2.385e3, 0, 0);
+    assert_close(m->gravity, 9.8, 0, 0);
+    assert_close(m->blocks[0].mass, 1.5, 0, 0);
+    assert_close(m->blocks[1].mass, 2.5, 0, 0);
+    assert_close(m->blocks[2].mass, 1.5, 0, 0);
+    assert_close(m->blocks[0].normal_force, 1.5 * 9.8, 1e-15, 0); /* m g */
+    assert_close(m->blocks[1].normal_force, 30, 0, 0);
+    assert_close(m->blocks[0].x_init, 1e-6, 0, 0);
+    assert_close(m->blocks[1].v_init, -0.01, 0, 0);
+    assert_close(m->blocks[2].v_init, 0.0, 0, 0);
+    assert_ptr_equal(m->blocks[2].law, &bk_friction_coulomb);
+    assert_close(m->blocks[0].friction_params[1], 0.5, 0, 0);
+    assert_close(m->blocks[2].friction_params[0], 0.6, 0, 0); /* inherited */
+    assert_close(m->blocks[2].friction_params[1], 0.4, 0, 0); /* overridden */
+    assert_int_equal(m->n_friction_state, 0);
+    assert_close(m->driver.velocity, 2e-3, 0, 0);
+    assert_close(m->driver.start_position, 1e-4, 0, 0);
+    assert_int_equal(m->spring, BK_SPRING_TENSION_ONLY);
+    assert_string_equal(c->solver.method, "cvode_bdf");
+    assert_string_equal(c->solver.linear_solver, "band");
+    assert_close(c->solver.rtol, 1e-9, 0, 0);
+    assert_close(c->solver.atol_x, 1e-15, 0, 0);
+    assert_true(isnan(c->solver.atol_v) && isnan(c->solver.max_step) && isnan(c->solver.instant_window));
+    assert_int_equal(c->solver.max_steps, 5000);
+    assert_int_equal(c->solver.detect_velocity_extrema, 0);
+    assert_int_equal(c->solver.max_transitions_per_instant, 7);
+    assert_string_equal(c->output.path, "out/x.h5");
+    assert_close(c->output.interval, 0.01, 0, 0);
+    assert_int_equal(c->output.fields, BK_FIELD_X | BK_FIELD_V | BK_FIELD_MODE);
+    assert_int_equal(c->output.transitions, 0);
+    assert_int_equal(c->output.event_rows, 1);
+    assert_close(c->t_end, 2.5, 0, 0);
+    assert_string_equal(c->source_name, "full.ini");
+    assert_string_equal(c->text, full_config);
+    bk_config_free(c);
+}
+
+static void test_defaults(void **state)
+{
+    (void)state;
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(minimal_config, "some/dir/case_q.ini", NULL, 0, &c, &err), BK_OK);
+    assert_int_equal(c->model->boundary, BK_BOUNDARY_FREE);
+    assert_int_equal(c->model->spring, BK_SPRING_LINEAR);
+    assert_close(c->model->gravity, 9.81, 0, 0);
+    assert_close(c->model->blocks[0].normal_force, 9.81, 0, 0);
+    assert_string_equal(c->solver.method, "cvode_adams");
+    assert_string_equal(c->solver.linear_solver, "auto");
+    assert_close(c->solver.rtol, 1e-8, 0, 0);
+    assert_int_equal(c->solver.max_steps, 100000);
+    assert_int_equal(c->solver.detect_velocity_extrema, 1);
+    assert_int_equal(c->solver.max_transitions_per_instant, 100);
+    assert_string_equal(c->output.path, "case_q.h5");
+    assert_close(c->output.interval, 5e-3, 1e-15, 0); /* t_end / 1000 */
+    assert_int_equal(c->output.fields, BK_FIELD_ALL);
+    assert_int_equal(c->output.transitions, 1);
+    bk_config_free(c);
+}
+
+/* Indented keys, a 190-character line, CRLF line ends and ';' comments are all fine. */
+static void test_tolerated_forms(void **state)
+{
+    (void)state;
+    char text[2048];
+    char comment[200];
+    memset(comment, 'x', 188);
+    comment[0] = ';';
+    comment[188] = '\0';
+    snprintf(text, sizeof text,
+             "%s\r\n[model]\r\n  n_blocks = 1   ; one\r\n[block]\n\tmass = 1\n  driver_stiffness=1e4\n"
+             "[friction]\nlaw=coulomb\nmu_s = 0.6\nmu_d = 0.5\n[driver]\nvelocity = 1e-3\n[run]\nt_end = 5",
+             comment);
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(text, "t.ini", NULL, 0, &c, &err), BK_OK);
+    assert_close(c->model->blocks[0].mass, 1.0, 0, 0);
+    bk_config_free(c);
+}
+
+/* Replace the line `line` (with its '\n') of minimal_config by `replacement`. */
+static void variant(char *out, size_t len, const char *line, const char *replacement)
+{
+    const char *at = strstr(minimal_config, line);
+    assert_non_null(at);
+    snprintf(out, len, "%.*s%s%s", (int)(at - minimal_config), minimal_config, replacement,
+             at + strlen(line));
+}
+
+typedef struct rejection {
+    const char *line, *replacement, *message;
+} rejection;
+
+static void test_rejections(void **state)
+{
+    (void)state;
+    char long_line[300];
+    memset(long_line, 'y', 250);
+    memcpy(long_line, "mass = 1 ;", 10);
+    long_line[250] = '\n';
+    long_line[251] = '\0';
+    const rejection cases[] = {
+        {"[model]\n", "[modle]\n",
+         "t.ini:1: [modle]: unknown section (allowed: model, block, block.I, friction, friction.I, driver, "
+         "solver, output, run; I is a block index from 0)"},
+        {"mass = 1\n", "mass = 1\nmas = 2\n",
+         "t.ini:5: [block] mas: unknown key (allowed: mass, driver_stiffness, normal_force, x_init, v_init)"},
+        {"mass = 1\n", "mass = 1\nmass = 2\n", "t.ini:5: [block] mass: duplicate key (first set at line 4)"},
+        {"n_blocks = 1\n", "", "t.ini: [model] n_blocks: required key missing (allowed: 1 <= n_blocks <= 1000000, an integer)"},
+        {"mass = 1\n", "", "t.ini: [block] mass: required key missing (allowed: 0 < mass < inf kg)"},
+        {"driver_stiffness = 1e4\n", "", "t.ini: [block] driver_stiffness: required key missing (allowed: 0 <= driver_stiffness < inf N/m)"},
+        {"law = coulomb\n", "", "t.ini: [friction] law: required key missing (allowed: coulomb)"},
+        {"mu_s = 0.6\n", "", "t.ini: [friction] mu_s: required key missing (allowed: 0 <= mu_s < inf)"},
+        {"velocity = 1e-3\n", "", "t.ini: [driver] velocity: required key missing (allowed: -inf < velocity < inf m/s)"},
+        {"t_end = 5\n", "", "t.ini: [run] t_end: required key missing (allowed: 0 < t_end < inf s)"},
+        {"mass = 1\n", "mass = heavy\n", "t.ini:4: [block] mass: not a number: \"heavy\" (allowed: 0 < mass < inf kg)"},
+        {"mass = 1\n", "mass = 2.0 # kg\n",
+         "t.ini:4: [block] mass: not a number: \"2.0 # kg\" (inline comments start with ';') (allowed: 0 < mass < inf kg)"},
+        {"mass = 1\n", "mass = 1.5x\n", "t.ini:4: [block] mass: not a number: \"1.5x\""},
+        {"mass = 1\n", "mass =\n", "t.ini:4: [block] mass: not a number: \"\""},
+        {"mass = 1\n", "mass = nan\n", "t.ini:4: [block] mass: not a number: \"nan\""},
+        {"mass = 1\n", "mass = inf\n", "t.ini:4: [block] mass: not a number: \"inf\""},
+        {"mass = 1\n", "mass = -inf\n", "t.ini:4: [block] mass: not a number: \"-inf\""},
+        {"mass = 1\n", "mass = 1e999\n", "t.ini:4: [block] mass: not a number: \"1e999\""},
+        {"mass = 1\n", "mass = -1\n", "t.ini:4: [block] mass: out of range, got -1 (allowed: 0 < mass < inf kg)"},
+        {"mass = 1\n", "mass = 0\n", "t.ini:4: [block] mass: out of range, got 0 (allowed: 0 < mass < inf kg)"},
+        {"driver_stiffness = 1e4\n", "driver_stiffness = -5\n",
+         "t.ini:5: [block] driver_stiffness: out of range, got -5 (allowed: 0 <= driver_stiffness < inf N/m)"},
+        {"n_blocks = 1\n", "n_blocks = 1.5\n", "t.ini:2: [model] n_blocks: not an integer: \"1.5\""},
+        {"n_blocks = 1\n", "n_blocks = 0\n", "t.ini:2: [model] n_blocks: out of range, got 0"},
+        {"n_blocks = 1\n", "n_blocks = 1\ncoupling_stiffness = -1\n",
+         "t.ini:3: [model] coupling_stiffness: out of range, got -1 (allowed: 0 <= coupling_stiffness < inf N/m)"},
+        {"mu_d = 0.5\n", "mu_d = 0.7\n", "t.ini:9: [friction] mu_d: must be <= mu_s (0.6), got 0.7"},
+        {"mu_d = 0.5\n", "mu_d = -0.1\n", "t.ini:9: [friction] mu_d: out of range, got -0.1 (allowed: 0 <= mu_d < inf)"},
+        {"mu_d = 0.5\n", "mu_d = 0.5\nv0 = 100\n",
+         "t.ini:10: [friction] v0: not a parameter of law 'coulomb' (known: law, mu_s, mu_d)"},
+        {"law = coulomb\n", "law = magic\n", "t.ini:7: [friction] law: unknown value \"magic\" (allowed: coulomb)"},
+        {"t_end = 5\n", "t_end = 0\n", "t.ini:13: [run] t_end: out of range, got 0 (allowed: 0 < t_end < inf s)"},
+        {"t_end = 5\n", "t_end = -3\n", "t.ini:13: [run] t_end: out of range, got -3"},
+        {"t_end = 5\n", "t_end = 5\n[solver]\nrtol = 1\n",
+         "t.ini:15: [solver] rtol: out of range, got 1 (allowed: 1e-15 <= rtol <= 0.1)"},
+        {"t_end = 5\n", "t_end = 5\n[solver]\nmethod = euler\n",
+         "t.ini:15: [solver] method: unknown value \"euler\" (allowed: cvode_adams, cvode_bdf)"},
+        {"t_end = 5\n", "t_end = 5\n[solver]\ndetect_velocity_extrema = maybe\n",
+         "t.ini:15: [solver] detect_velocity_extrema: not a boolean: \"maybe\" (allowed: true, false, yes, no, on, off, 1, 0)"},
+        {"t_end = 5\n", "t_end = 5\n[output]\nfields = x, speed\n",
+         "t.ini:15: [output] fields: unknown field \"speed\" (allowed: all, or a list of x, v, friction, cof, mode, energy, state)"},
+        {"t_end = 5\n", "t_end = 5\n[output]\ninterval = 6\n", "t.ini:15: [output] interval: must be <= t_end (5 s), got 6"},
+        {"t_end = 5\n", "t_end = 5\n[output]\npath =\n", "t.ini:15: [output] path: empty value"},
+        {"velocity = 1e-3\n", "velocity = 1e-3\nspring = elastic\n",
+         "t.ini:12: [driver] spring: unknown value \"elastic\" (allowed: linear, tension_only)"},
+        {"mass = 1\n", "mass = 1\n[block.1]\nmass = 2\n", "t.ini:5: [block.1]: block index out of range (allowed: 0..0)"},
+        {"mass = 1\n", "mass = 1\n[block.x]\nmass = 2\n", "t.ini:5: [block.x]: unknown section"},
+        {"mass = 1\n", "mass = 1\n[driver.0]\nvelocity = 2\n", "t.ini:5: [driver.0]: unknown section"},
+        {"mass = 1\n", long_line, "t.ini:4: line longer than 190 characters (250); split it"},
+        {"mass = 1\n", "mass 1\n", "t.ini:4: syntax error"},
+        {"[block]\n", "[block\n", "t.ini:3: syntax error"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        char text[4096];
+        variant(text, sizeof text, cases[k].line, cases[k].replacement);
+        bk_config *c = (bk_config *)&c; /* must be reset to NULL */
+        bk_error err = {0};
+        int rc = bk_config_load_string(text, "t.ini", NULL, 0, &c, &err);
+        if (rc != BK_ERR_CONFIG || !strstr(err.message, cases[k].message))
+            print_error("case %zu: rc %d\n got:      %s\n expected: %s\n", k, rc, err.message,
+                        cases[k].message);
+        assert_int_equal(rc, BK_ERR_CONFIG);
+        assert_null(c);
+        assert_non_null(strstr(err.message, cases[k].message));
+    }
+}
+
+/* The first error in file order wins. */
+static void test_first_error_reported(void **state)
+{
+    (void)state;
+    char text[4096];
+    variant(text, sizeof text, "mass = 1\n", "mass = -1\n");
+    char both[4096];
+    snprintf(both, sizeof both, "%s", text);
+    char *t_end = strstr(both, "t_end = 5");
+    assert_non_null(t_end);
+    memcpy(t_end, "t_end =-5", 9);
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(both, "t.ini", NULL, 0, &c, &err), BK_ERR_CONFIG);
+    assert_non_null(strstr(err.message, "t.ini:4: [block] mass"));
+}
+
+static void test_overrides(void **state)
+{
+    (void)state;
+    const char *ok[] = {"friction.mu_d=0.3", "block.0.mass = 2", "solver.rtol=1e-10", "output.path=o.h5"};
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(minimal_config, "t.ini", ok, 4, &c, &err), BK_OK);
+    assert_close(c->model->blocks[0].friction_params[1], 0.3, 0, 0);
+    assert_close(c->model->blocks[0].mass, 2.0, 0, 0);
+    assert_close(c->model->blocks[0].normal_force, 2.0 * 9.81, 1e-15, 0);
+    assert_close(c->solver.rtol, 1e-10, 0, 0);
+    assert_string_equal(c->output.path, "o.h5");
+    assert_non_null(strstr(c->text, "; --set friction.mu_d=0.3\n"));
+    assert_non_null(strstr(c->text, "; --set block.0.mass = 2\n"));
+    bk_config_free(c);
+
+    const char *bad_value[] = {"block.mass=0"};
+    assert_int_equal(bk_config_load_string(minimal_config, "t.ini", bad_value, 1, &c, &err), BK_ERR_CONFIG);
+    assert_null(c);
+    assert_string_equal(err.message, "--set block.mass=0: [block] mass: out of range, got 0 (allowed: 0 < mass < inf kg)");
+    const char *malformed[] = {"blockmass=2"};
+    assert_int_equal(bk_config_load_string(minimal_config, "t.ini", malformed, 1, &c, &err), BK_ERR_CONFIG);
+    assert_non_null(strstr(err.message, "--set blockmass=2: expected section.key=value"));
+    const char *no_equals[] = {"block.mass"};
+    assert_int_equal(bk_config_load_string(minimal_config, "t.ini", no_equals, 1, &c, &err), BK_ERR_CONFIG);
+    assert_non_null(strstr(err.message, "expected section.key=value"));
+    const char *unknown[] = {"block.colour=red"};
+    assert_int_equal(bk_config_load_string(minimal_config, "t.ini", unknown, 1, &c, &err), BK_ERR_CONFIG);
+    assert_non_null(strstr(err.message, "--set block.colour=red: [block] colour: unknown key"));
+}
+
+static void test_file_errors(void **state)
+{
+    (void)state;
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_file("/nonexistent/dir/x.ini", NULL, 0, &c, &err), BK_ERR_IO);
+    assert_null(c);
+    assert_non_null(strstr(err.message, "/nonexistent/dir/x.ini: cannot open: No such file or directory"));
+    char path[] = "/tmp/bksim_cfg_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    assert_int_equal(write(fd, "[model]\n\0\n", 10), 10);
+    close(fd);
+    assert_int_equal(bk_config_load_file(path, NULL, 0, &c, &err), BK_ERR_CONFIG);
+    assert_non_null(strstr(err.message, "NUL"));
+    unlink(path);
+}
+
+/* A [friction.I] that changes law takes none of [friction]'s parameters; a per-block
+ * override of the same law inherits them. */
+static void test_per_block_friction(void **state)
+{
+    (void)state;
+    char text[4096];
+    snprintf(text, sizeof text, "%s", minimal_config);
+    char *model = strstr(text, "n_blocks = 1");
+    model[11] = '2';
+    strcat(text, "[friction.1]\nlaw = coulomb\nmu_d = 0.2\n");
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(text, "t.ini", NULL, 0, &c, &err), BK_OK);
+    assert_close(c->model->blocks[1].friction_params[0], 0.6, 0, 0);
+    assert_close(c->model->blocks[1].friction_params[1], 0.2, 0, 0);
+    assert_close(c->model->blocks[0].friction_params[1], 0.5, 0, 0);
+    bk_config_free(c);
+    /* mu_d above the inherited mu_s is reported at the override's line */
+    strcat(text, "mu_s = 0.1\n");
+    assert_int_equal(bk_config_load_string(text, "t.ini", NULL, 0, &c, &err), BK_ERR_CONFIG);
+    if (!strstr(err.message, "t.ini:16: [friction.1] mu_d: must be <= mu_s (0.1), got 0.2"))
+        print_error("%s\n", err.message);
+    assert_non_null(strstr(err.message, "t.ini:16: [friction.1] mu_d: must be <= mu_s (0.1), got 0.2"));
+}
+
+/* Every shipped config loads (tests run from the repository root). */
+static void test_shipped_configs(void **state)
+{
+    (void)state;
+    glob_t g;
+    assert_int_equal(glob("configs/*/*.ini", 0, NULL, &g), 0);
+    assert_true(g.gl_pathc >= 8);
+    for (size_t i = 0; i < g.gl_pathc; ++i) {
+        bk_config *c = NULL;
+        bk_error err = {0};
+        int rc = bk_config_load_file(g.gl_pathv[i], NULL, 0, &c, &err);
+        if (rc != BK_OK)
+            print_error("%s\n", err.message);
+        assert_int_equal(rc, BK_OK);
+        bk_config_free(c);
+    }
+    globfree(&g);
+}
+
+static void test_reference(void **state)
+{
+    (void)state;
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    bk_config_write_reference(f);
+    fclose(f);
+    const char *expect[] = {"### [model]", "| `n_blocks` |", "| `mass` | kg | required | 0 < mass < inf kg |",
+                            "### [friction] law = coulomb", "| `mu_d` |", "| `t_end` | s |",
+                            "| `interval` | s | t_end / 1000 |"};
+    for (size_t k = 0; k < sizeof expect / sizeof expect[0]; ++k) {
+        if (!strstr(buf, expect[k]))
+            print_error("missing: %s\n", expect[k]);
+        assert_non_null(strstr(buf, expect[k]));
+    }
+    free(buf);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_full_config),
+        cmocka_unit_test(test_defaults),
+        cmocka_unit_test(test_tolerated_forms),
+        cmocka_unit_test(test_rejections),
+        cmocka_unit_test(test_first_error_reported),
+        cmocka_unit_test(test_overrides),
+        cmocka_unit_test(test_file_errors),
+        cmocka_unit_test(test_per_block_friction),
+        cmocka_unit_test(test_shipped_configs),
+        cmocka_unit_test(test_reference),
+    };
+    return cmocka_run_group_tests_name("config", tests, NULL, NULL);
+}

@@ -1,0 +1,157 @@
+/* Chain forces and energies: hand-computed forces for every boundary, energy gradients
+ * against forces, the frequency bound against GSL's eigenvalues. */
+#include <gsl/gsl_eigen.h>
+#include <gsl/gsl_matrix.h>
+#include <stdlib.h>
+
+#include "bk_test.h"
+#include "bksim/model.h"
+
+static bk_model *make_chain(size_t n, bk_boundary boundary, bk_spring spring)
+{
+    bk_model *m = bk_model_create(n);
+    assert_non_null(m);
+    m->boundary = boundary;
+    m->spring = spring;
+    m->coupling_stiffness = 2.385e3;
+    for (size_t i = 0; i < n; ++i) {
+        m->blocks[i].mass = 1.0 + 0.25 * (double)i;
+        m->blocks[i].driver_stiffness = 1e4 * (1.0 + 0.1 * (double)i);
+        m->blocks[i].normal_force = 9.81;
+        m->blocks[i].law = &bk_friction_coulomb;
+    }
+    bk_model_finalize(m);
+    return m;
+}
+
+static void test_forces_free(void **state)
+{
+    (void)state;
+    bk_model *m = make_chain(3, BK_BOUNDARY_FREE, BK_SPRING_LINEAR);
+    double x[3] = {1e-3, -2e-3, 4e-3}, D = 5e-3, kc = m->coupling_stiffness;
+    assert_close(bk_model_applied_force(m, 0, x, D), 1e4 * (D - x[0]) + kc * (x[1] - x[0]), 1e-15, 0);
+    assert_close(bk_model_applied_force(m, 1, x, D),
+                 1.1e4 * (D - x[1]) + kc * (x[0] - x[1]) + kc * (x[2] - x[1]), 1e-15, 0);
+    assert_close(bk_model_applied_force(m, 2, x, D), 1.2e4 * (D - x[2]) + kc * (x[1] - x[2]), 1e-15, 0);
+    assert_int_equal(bk_model_coupling_count(m, 0), 1);
+    assert_int_equal(bk_model_coupling_count(m, 1), 2);
+    bk_model_free(m);
+}
+
+static void test_forces_fixed_and_periodic(void **state)
+{
+    (void)state;
+    double x[3] = {1e-3, -2e-3, 4e-3}, kc = 2.385e3;
+    bk_model *fixed = make_chain(3, BK_BOUNDARY_FIXED, BK_SPRING_LINEAR);
+    assert_close(bk_model_coupling_force(fixed, 0, x), kc * (0 - x[0]) + kc * (x[1] - x[0]), 1e-15, 0);
+    assert_close(bk_model_coupling_force(fixed, 2, x), kc * (x[1] - x[2]) + kc * (0 - x[2]), 1e-15, 0);
+    bk_model *ring = make_chain(3, BK_BOUNDARY_PERIODIC, BK_SPRING_LINEAR);
+    assert_close(bk_model_coupling_force(ring, 0, x), kc * (x[2] - x[0]) + kc * (x[1] - x[0]), 1e-15, 0);
+    assert_close(bk_model_coupling_force(ring, 2, x), kc * (x[1] - x[2]) + kc * (x[0] - x[2]), 1e-15, 0);
+    /* A single block: periodic couples to nothing, fixed to both walls. */
+    bk_model *one_ring = make_chain(1, BK_BOUNDARY_PERIODIC, BK_SPRING_LINEAR);
+    assert_close(bk_model_coupling_force(one_ring, 0, x), 0.0, 0, 0);
+    bk_model *one_fixed = make_chain(1, BK_BOUNDARY_FIXED, BK_SPRING_LINEAR);
+    assert_close(bk_model_coupling_force(one_fixed, 0, x), -2.0 * kc * x[0], 1e-15, 0);
+    long left, right;
+    bk_model *two_ring = make_chain(2, BK_BOUNDARY_PERIODIC, BK_SPRING_LINEAR);
+    bk_model_neighbours(two_ring, 0, &left, &right);
+    assert_int_equal(left, 1);
+    assert_int_equal(right, 1);
+    bk_model_free(fixed);
+    bk_model_free(ring);
+    bk_model_free(one_ring);
+    bk_model_free(one_fixed);
+    bk_model_free(two_ring);
+}
+
+static void test_tension_only(void **state)
+{
+    (void)state;
+    bk_model *m = make_chain(1, BK_BOUNDARY_FREE, BK_SPRING_TENSION_ONLY);
+    assert_close(bk_model_driver_force(m, 0, 2e-3, 1e-3), 0.0, 0, 0);          /* ahead: slack */
+    assert_close(bk_model_driver_force(m, 0, 1e-3, 3e-3), 1e4 * 2e-3, 1e-15, 0); /* behind: pulls */
+    double x = 2e-3;
+    assert_close(bk_model_elastic_energy(m, &x, 1e-3), 0.0, 0, 0);
+    bk_model_free(m);
+}
+
+/* The force is minus the gradient of the elastic energy, for every boundary and spring. */
+static void test_energy_gradient(void **state)
+{
+    (void)state;
+    const bk_boundary boundaries[] = {BK_BOUNDARY_FREE, BK_BOUNDARY_FIXED, BK_BOUNDARY_PERIODIC};
+    const bk_spring springs[] = {BK_SPRING_LINEAR, BK_SPRING_TENSION_ONLY};
+    for (size_t b = 0; b < 3; ++b)
+        for (size_t s = 0; s < 2; ++s)
+            for (size_t n = 1; n <= 4; ++n) {
+                bk_model *m = make_chain(n, boundaries[b], springs[s]);
+                double x[4] = {1.1e-3, -2.3e-3, 4.7e-3, 0.3e-3}, D = 2e-3;
+                for (size_t i = 0; i < n; ++i) {
+                    double h = 1e-7, saved = x[i];
+                    x[i] = saved + h;
+                    double up = bk_model_elastic_energy(m, x, D);
+                    x[i] = saved - h;
+                    double down = bk_model_elastic_energy(m, x, D);
+                    x[i] = saved;
+                    double force = bk_model_applied_force(m, i, x, D);
+                    assert_close(-(up - down) / (2 * h), force, 1e-6, 1e-9);
+                }
+                bk_model_free(m);
+            }
+}
+
+static void test_kinetic_energy(void **state)
+{
+    (void)state;
+    bk_model *m = make_chain(2, BK_BOUNDARY_FREE, BK_SPRING_LINEAR);
+    double v[2] = {0.3, -0.2};
+    assert_close(bk_model_kinetic_energy(m, v), 0.5 * 1.0 * 0.09 + 0.5 * 1.25 * 0.04, 1e-15, 0);
+    bk_model_free(m);
+}
+
+/* The Gershgorin bound is above the largest eigenfrequency and within a factor 2 of it. */
+static void test_frequency_bound(void **state)
+{
+    (void)state;
+    const bk_boundary boundaries[] = {BK_BOUNDARY_FREE, BK_BOUNDARY_FIXED, BK_BOUNDARY_PERIODIC};
+    for (size_t b = 0; b < 3; ++b) {
+        size_t n = 6;
+        bk_model *m = make_chain(n, boundaries[b], BK_SPRING_LINEAR);
+        /* Symmetric form M^-1/2 K M^-1/2 from unit displacements. */
+        gsl_matrix *a = gsl_matrix_alloc(n, n);
+        double x[6];
+        for (size_t j = 0; j < n; ++j) {
+            for (size_t i = 0; i < n; ++i)
+                x[i] = i == j ? 1.0 : 0.0;
+            for (size_t i = 0; i < n; ++i) {
+                double k_ij = -bk_model_applied_force(m, i, x, 0.0);
+                gsl_matrix_set(a, i, j, k_ij / sqrt(m->blocks[i].mass * m->blocks[j].mass));
+            }
+        }
+        gsl_vector *eval = gsl_vector_alloc(n);
+        gsl_eigen_symm_workspace *w = gsl_eigen_symm_alloc(n);
+        gsl_eigen_symm(a, eval, w);
+        double max_eval = gsl_vector_max(eval);
+        double bound = bk_model_max_angular_frequency(m);
+        assert_true(bound >= sqrt(max_eval) * (1 - 1e-12));
+        assert_true(bound <= 2.0 * sqrt(max_eval));
+        gsl_eigen_symm_free(w);
+        gsl_vector_free(eval);
+        gsl_matrix_free(a);
+        bk_model_free(m);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_forces_free),
+        cmocka_unit_test(test_forces_fixed_and_periodic),
+        cmocka_unit_test(test_tension_only),
+        cmocka_unit_test(test_energy_gradient),
+        cmocka_unit_test(test_kinetic_energy),
+        cmocka_unit_test(test_frequency_bound),
+    };
+    return cmocka_run_group_tests_name("model", tests, NULL, NULL);
+}

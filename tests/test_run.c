@@ -1,0 +1,515 @@
+/* The run loop against exact answers: the Coulomb single block (paper cases A, B, C, both
+ * spring variants) against its closed form, the hidden-stop and re-fire traps, energy
+ * balance of chains, simultaneous transitions, and the chattering guard. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bk_test.h"
+#include "bksim/bksim.h"
+#include "exact_single.h"
+
+/* --- a memory sink --------------------------------------------------------------------- */
+
+typedef struct recorder {
+    bk_transition *transitions;
+    size_t n_transitions, cap_transitions;
+    size_t rows;
+    double last_t;
+    int time_decreased;
+    const exact_solution *exact; /* when set: track the position error at every row */
+    double max_position_error;
+    double max_balance_error;    /* |W - dE_el - dE_kin - D| over rows */
+    double elastic0, kinetic0;
+} recorder;
+
+static int record_sample(void *self, const bk_sample *s, bk_error *err)
+{
+    (void)err;
+    recorder *r = self;
+    if (r->rows > 0 && !(s->t > r->last_t))
+        r->time_decreased = 1;
+    if (r->rows == 0) {
+        r->elastic0 = s->elastic_energy;
+        r->kinetic0 = s->kinetic_energy;
+    }
+    r->last_t = s->t;
+    r->rows++;
+    double balance = s->work_driver - (s->elastic_energy - r->elastic0) -
+                     (s->kinetic_energy - r->kinetic0) - s->dissipation;
+    if (fabs(balance) > r->max_balance_error)
+        r->max_balance_error = fabs(balance);
+    if (r->exact) {
+        double x, v;
+        exact_state(r->exact, s->t, &x, &v);
+        if (fabs(s->x[0] - x) > r->max_position_error)
+            r->max_position_error = fabs(s->x[0] - x);
+    }
+    return BK_OK;
+}
+
+static int record_transition(void *self, const bk_transition *t, bk_error *err)
+{
+    (void)err;
+    recorder *r = self;
+    if (r->n_transitions == r->cap_transitions) {
+        size_t cap = r->cap_transitions ? 2 * r->cap_transitions : 64;
+        bk_transition *grown = realloc(r->transitions, cap * sizeof *grown);
+        if (!grown)
+            return BK_ERR_NOMEM;
+        r->transitions = grown;
+        r->cap_transitions = cap;
+    }
+    r->transitions[r->n_transitions++] = *t;
+    return BK_OK;
+}
+
+static void recorder_free(recorder *r) { free(r->transitions); }
+
+/* --- scenes built in code (the parser has its own tests) ------------------------------- */
+
+typedef struct scene_spec {
+    size_t n;
+    double mass, stiffness, coupling, mu_s, mu_d, velocity, t_end, rtol, interval;
+    bk_spring spring;
+    bk_boundary boundary;
+    const char *method;
+    int detect_extrema;
+    long max_per_instant;
+} scene_spec;
+
+static scene_spec paper_case(double mu_d, bk_spring spring, double rtol)
+{
+    return (scene_spec){.n = 1, .mass = 1.0, .stiffness = 1e4, .coupling = 0.0, .mu_s = 0.6,
+                        .mu_d = mu_d, .velocity = 1e-3, .t_end = 5.0, .rtol = rtol,
+                        .interval = 1e-3, .spring = spring, .boundary = BK_BOUNDARY_FREE,
+                        .method = "cvode_adams", .detect_extrema = 1, .max_per_instant = 100};
+}
+
+static bk_config *make_config(const scene_spec *spec)
+{
+    bk_config *c = calloc(1, sizeof *c);
+    assert_non_null(c);
+    bk_model *m = bk_model_create(spec->n);
+    assert_non_null(m);
+    m->boundary = spec->boundary;
+    m->coupling_stiffness = spec->coupling;
+    m->gravity = 9.81;
+    m->spring = spec->spring;
+    m->driver.velocity = spec->velocity;
+    for (size_t i = 0; i < spec->n; ++i) {
+        bk_block *b = &m->blocks[i];
+        b->mass = spec->mass;
+        b->driver_stiffness = spec->stiffness;
+        b->normal_force = spec->mass * 9.81;
+        b->law = &bk_friction_coulomb;
+        b->friction_params[0] = spec->mu_s;
+        b->friction_params[1] = spec->mu_d;
+    }
+    bk_model_finalize(m);
+    c->model = m;
+    c->t_end = spec->t_end;
+    snprintf(c->solver.method, sizeof c->solver.method, "%s", spec->method);
+    snprintf(c->solver.linear_solver, sizeof c->solver.linear_solver, "auto");
+    c->solver.rtol = spec->rtol;
+    c->solver.atol_x = c->solver.atol_v = c->solver.max_step = NAN;
+    c->solver.max_steps = 1000000;
+    c->solver.detect_velocity_extrema = spec->detect_extrema;
+    c->solver.max_transitions_per_instant = spec->max_per_instant;
+    c->solver.instant_window = NAN;
+    c->output.interval = spec->interval;
+    c->output.fields = BK_FIELD_ALL;
+    c->output.transitions = 1;
+    c->output.event_rows = 1;
+    return c;
+}
+
+static void free_config(bk_config *c)
+{
+    bk_model_free(c->model);
+    free(c);
+}
+
+static int run_spec(const scene_spec *spec, recorder *r, bk_run_stats *stats, bk_error *err)
+{
+    bk_config *c = make_config(spec);
+    bk_sink sink = {r, record_sample, record_transition};
+    int rc = bk_run(c, &sink, stats, NULL, NULL, err);
+    free_config(c);
+    return rc;
+}
+
+/* --- the Coulomb single block against its closed form ---------------------------------- */
+
+static void compare_with_exact(double mu_d, bk_spring spring)
+{
+    scene_spec spec = paper_case(mu_d, spring, 1e-10);
+    exact_params p = {1.0, 1e4, 9.81, 0.6, mu_d, 1e-3, spring == BK_SPRING_TENSION_ONLY};
+    exact_solution ex;
+    assert_int_equal(exact_solve(&p, spec.t_end, &ex), 0);
+    recorder r = {0};
+    r.exact = &ex;
+    bk_run_stats stats;
+    bk_error err = {0};
+    assert_int_equal(run_spec(&spec, &r, &stats, &err), BK_OK);
+    assert_int_equal(r.n_transitions, ex.n_events);
+    assert_false(r.time_decreased);
+
+    /* First slip: mu_s m g / (k V) = 0.5886 s. */
+    assert_close(r.transitions[0].t, 0.5886, 1e-14, 0.0);
+    assert_close(r.transitions[0].t, ex.events[0].t, 1e-14, 0.0);
+
+    /* Every phase: slip durations and distances, stick durations, and each full cycle
+     * (breakaway to breakaway). */
+    double accel_at_stop = (0.6 - mu_d) * 9.81; /* A w = (mu_s - mu_d) g at a slip end, m/s^2 */
+    for (size_t k = 0; k + 1 < ex.n_events; ++k) {
+        assert_int_equal(r.transitions[k].from, ex.events[k].from);
+        assert_int_equal(r.transitions[k].to, ex.events[k].to);
+        double duration = r.transitions[k + 1].t - r.transitions[k].t;
+        double exact_duration = ex.events[k + 1].t - ex.events[k].t;
+        if (ex.events[k].to != BK_MODE_STICK) {
+            double slip = r.transitions[k + 1].x - r.transitions[k].x;
+            double exact_slip = ex.events[k + 1].x - ex.events[k].x;
+            assert_close(slip, exact_slip, 1e-8, 0.0);
+        } else {
+            /* k is a stop; k - 1 and k + 1 are breakaways: one full cycle. */
+            assert_close(r.transitions[k + 1].t - r.transitions[k - 1].t,
+                         ex.events[k + 1].t - ex.events[k - 1].t, 1e-8, 0.0);
+        }
+        if (mu_d < 0.59) {
+            assert_close(duration, exact_duration, 1e-8, 0.0);
+        } else {
+            /* Case C stops by grazing: v touches zero with a = -A w ~ -1e-3 m/s^2, so a
+             * velocity error dv moves the stop by dv / (A w), about 1 s times the relative
+             * velocity error.  Slips (63 ms) and sticks (0.2 ms) both start or end at such a
+             * stop; they are held to that conditioning, the cycles above to 1e-8. */
+            double bound = 100.0 * spec.rtol * spec.velocity / accel_at_stop;
+            assert_close(duration, exact_duration, 0.0, bound);
+        }
+    }
+    /* The time series follows the closed form everywhere (positions near an event move by
+     * v dt with the event's tiny time error). */
+    print_message("max position error %.3g m, energy residual %.3g\n", r.max_position_error,
+                  stats.energy_residual);
+    assert_true(r.max_position_error < 1e-7 * 0.6 * 9.81 / 1e4);
+    assert_true(fabs(stats.energy_residual) < 1e-8);
+    recorder_free(&r);
+    exact_free(&ex);
+}
+
+static void test_case_a_linear(void **state)
+{
+    (void)state;
+    compare_with_exact(0.1, BK_SPRING_LINEAR);
+}
+static void test_case_b_linear(void **state)
+{
+    (void)state;
+    compare_with_exact(0.5, BK_SPRING_LINEAR);
+}
+static void test_case_c_linear(void **state)
+{
+    (void)state;
+    compare_with_exact(0.5999, BK_SPRING_LINEAR);
+}
+static void test_case_a_tension_only(void **state)
+{
+    (void)state;
+    compare_with_exact(0.1, BK_SPRING_TENSION_ONLY);
+}
+static void test_case_b_tension_only(void **state)
+{
+    (void)state;
+    compare_with_exact(0.5, BK_SPRING_TENSION_ONLY);
+}
+static void test_case_c_tension_only(void **state)
+{
+    (void)state;
+    compare_with_exact(0.5999, BK_SPRING_TENSION_ONLY);
+}
+
+/* The paper's case A numbers: first slip at 0.5886 s lasting 31.82 ms. */
+static void test_case_a_paper_numbers(void **state)
+{
+    (void)state;
+    scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, 1e-10);
+    recorder r = {0};
+    bk_error err = {0};
+    assert_int_equal(run_spec(&spec, &r, NULL, &err), BK_OK);
+    assert_true(r.n_transitions >= 2);
+    assert_close(r.transitions[0].t, 0.5886, 1e-12, 0.0);
+    double w = 100.0, V = 1e-3, A = (0.6 - 0.1) * 9.81 / 1e4 * w;
+    double t_slip = 2.0 * (3.14159265358979323846 - atan(A / V)) / w;
+    assert_close(r.transitions[1].t - r.transitions[0].t, t_slip, 1e-8, 0.0);
+    assert_close(t_slip, 31.82e-3, 1e-3, 0.0);
+    recorder_free(&r);
+}
+
+/* Position error falls as rtol tightens. */
+static void test_error_shrinks_with_rtol(void **state)
+{
+    (void)state;
+    const double mu_d[] = {0.1, 0.5};
+    for (size_t c = 0; c < 2; ++c) {
+        exact_params p = {1.0, 1e4, 9.81, 0.6, mu_d[c], 1e-3, 0};
+        exact_solution ex;
+        assert_int_equal(exact_solve(&p, 5.0, &ex), 0);
+        double previous = INFINITY;
+        const double rtols[] = {1e-5, 1e-7, 1e-9, 1e-11};
+        for (size_t k = 0; k < 4; ++k) {
+            scene_spec spec = paper_case(mu_d[c], BK_SPRING_LINEAR, rtols[k]);
+            recorder r = {0};
+            r.exact = &ex;
+            bk_error err = {0};
+            assert_int_equal(run_spec(&spec, &r, NULL, &err), BK_OK);
+            print_message("case mu_d=%g rtol %g: max position error %.3g m\n", mu_d[c], rtols[k],
+                          r.max_position_error);
+            assert_true(r.max_position_error < 0.5 * previous);
+            previous = r.max_position_error;
+            recorder_free(&r);
+        }
+        exact_free(&ex);
+    }
+}
+
+/* Case C ends every slip with a velocity dip through zero lasting ~0.2 ms: without the
+ * slip-rate minimum roots the integrator steps over most of them; with them, every stop is
+ * found. */
+static void test_case_c_hidden_stops(void **state)
+{
+    (void)state;
+    exact_params p = {1.0, 1e4, 9.81, 0.6, 0.5999, 1e-3, 0};
+    exact_solution ex;
+    assert_int_equal(exact_solve(&p, 5.0, &ex), 0);
+    assert_int_equal(ex.n_events, 141);
+    const double rtols[] = {1e-6, 1e-8};
+    for (size_t k = 0; k < 2; ++k) {
+        scene_spec spec = paper_case(0.5999, BK_SPRING_LINEAR, rtols[k]);
+        recorder with = {0}, without = {0};
+        bk_error err = {0};
+        assert_int_equal(run_spec(&spec, &with, NULL, &err), BK_OK);
+        spec.detect_extrema = 0;
+        assert_int_equal(run_spec(&spec, &without, NULL, &err), BK_OK);
+        print_message("case C rtol %g: %zu transitions with extremum roots, %zu without, exact %zu\n",
+                      rtols[k], with.n_transitions, without.n_transitions, ex.n_events);
+        assert_int_equal(with.n_transitions, ex.n_events);
+        assert_true(without.n_transitions < ex.n_events);
+        for (size_t j = 0; j < ex.n_events; ++j)
+            assert_close(with.transitions[j].t, ex.events[j].t, 0.0, 1e-4);
+        recorder_free(&with);
+        recorder_free(&without);
+    }
+    exact_free(&ex);
+}
+
+/* After a restart the root just handled must not fire again: transitions alternate
+ * stick/slip, never repeat at one instant, and match the exact count. */
+static void test_no_refire_after_restart(void **state)
+{
+    (void)state;
+    const double mu_d[] = {0.1, 0.5, 0.5999};
+    const char *methods[] = {"cvode_adams", "cvode_bdf"};
+    for (size_t m = 0; m < 2; ++m)
+        for (size_t c = 0; c < 3; ++c) {
+            scene_spec spec = paper_case(mu_d[c], BK_SPRING_LINEAR, 1e-9);
+            spec.method = methods[m];
+            recorder r = {0};
+            bk_error err = {0};
+            assert_int_equal(run_spec(&spec, &r, NULL, &err), BK_OK);
+            for (size_t k = 1; k < r.n_transitions; ++k) {
+                assert_int_equal(r.transitions[k].from, r.transitions[k - 1].to);
+                assert_true(r.transitions[k].t > r.transitions[k - 1].t);
+            }
+            recorder_free(&r);
+        }
+}
+
+/* --- chains ---------------------------------------------------------------------------- */
+
+static scene_spec chain(size_t n, double rtol)
+{
+    scene_spec s = paper_case(0.5, BK_SPRING_LINEAR, rtol);
+    s.n = n;
+    s.coupling = 2e4;
+    s.t_end = 3.0;
+    return s;
+}
+
+/* Driver work = elastic + kinetic energy change + frictional dissipation, to a residual
+ * that tightens with rtol. */
+static void check_energy(size_t n, bk_spring spring, bk_boundary boundary)
+{
+    double previous = INFINITY;
+    const double rtols[] = {1e-6, 1e-8, 1e-10};
+    for (size_t k = 0; k < 3; ++k) {
+        scene_spec spec = chain(n, rtols[k]);
+        spec.spring = spring;
+        spec.boundary = boundary;
+        bk_config *c = make_config(&spec);
+        /* Break the symmetry so blocks slip at different times. */
+        for (size_t i = 0; i < n; ++i) {
+            c->model->blocks[i].x_init = 1e-5 * sin(2.385 * (double)i);
+            c->model->blocks[i].friction_params[1] = 0.45 + 0.01 * (double)(i % 5);
+        }
+        recorder r = {0};
+        bk_sink sink = {&r, record_sample, record_transition};
+        bk_run_stats stats;
+        bk_error err = {0};
+        assert_int_equal(bk_run(c, &sink, &stats, NULL, NULL, &err), BK_OK);
+        double residual = fabs(stats.energy_residual);
+        print_message("%zu blocks rtol %g: %zu transitions, energy residual %.3g, work %.4g J\n", n,
+                      rtols[k], r.n_transitions, residual, stats.work_driver);
+        assert_true(r.n_transitions > 2 * n);
+        assert_true(stats.work_driver > 0.0);
+        assert_true(residual < 100.0 * rtols[k]);
+        assert_true(r.max_balance_error <= 100.0 * rtols[k] * stats.work_driver);
+        assert_true(residual < previous || residual < 1e-12);
+        previous = residual;
+        recorder_free(&r);
+        free_config(c);
+    }
+}
+
+static void test_energy_two_blocks(void **state)
+{
+    (void)state;
+    check_energy(2, BK_SPRING_LINEAR, BK_BOUNDARY_FREE);
+}
+
+static void test_energy_ten_blocks(void **state)
+{
+    (void)state;
+    check_energy(10, BK_SPRING_LINEAR, BK_BOUNDARY_FREE);
+    check_energy(10, BK_SPRING_TENSION_ONLY, BK_BOUNDARY_FIXED);
+    check_energy(10, BK_SPRING_LINEAR, BK_BOUNDARY_PERIODIC);
+}
+
+/* Identical uncoupled twins move identically: each breakaway and each stop is found for
+ * both blocks at one instant, in one event. */
+static void test_simultaneous_transitions(void **state)
+{
+    (void)state;
+    scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, 1e-10);
+    spec.n = 2;
+    spec.coupling = 3e3; /* coupled, but symmetric: the coupling never stretches */
+    recorder r = {0};
+    bk_error err = {0};
+    assert_int_equal(run_spec(&spec, &r, NULL, &err), BK_OK);
+    assert_int_equal(r.n_transitions, 20);
+    for (size_t k = 0; k + 1 < r.n_transitions; k += 2) {
+        assert_true(r.transitions[k].t == r.transitions[k + 1].t);
+        assert_int_equal(r.transitions[k].block, 0);
+        assert_int_equal(r.transitions[k + 1].block, 1);
+        assert_int_equal(r.transitions[k].to, r.transitions[k + 1].to);
+    }
+    recorder_free(&r);
+}
+
+/* A block whose stop finds the spring force beyond the threshold reverses at once
+ * (slip+ -> slip-), recorded as one transition. */
+static void test_reversal(void **state)
+{
+    (void)state;
+    scene_spec spec = paper_case(0.05, BK_SPRING_LINEAR, 1e-10);
+    spec.velocity = 0.0;
+    spec.t_end = 0.2;
+    bk_config *c = make_config(&spec);
+    /* Start sliding fast with no driver motion: the spring swings it back past its threshold. */
+    c->model->blocks[0].v_init = 0.5;
+    recorder r = {0};
+    bk_sink sink = {&r, record_sample, record_transition};
+    bk_error err = {0};
+    assert_int_equal(bk_run(c, &sink, NULL, NULL, NULL, &err), BK_OK);
+    assert_true(r.n_transitions >= 2);
+    assert_int_equal(r.transitions[0].from, BK_MODE_SLIP_POS);
+    assert_int_equal(r.transitions[0].to, BK_MODE_SLIP_NEG);
+    assert_true(fabs(r.transitions[0].force) > 0.6 * 9.81);
+    /* Energy bookkeeping covers the reversal. */
+    assert_true(r.max_balance_error < 1e-8);
+    recorder_free(&r);
+    free_config(c);
+}
+
+/* Transitions piling up at one instant stop the run with a message naming block and time. */
+static void test_chattering_guard(void **state)
+{
+    (void)state;
+    scene_spec spec = paper_case(0.5999, BK_SPRING_LINEAR, 1e-8);
+    spec.max_per_instant = 1;
+    bk_config *c = make_config(&spec);
+    /* Stop and breakaway 0.2 ms apart count as one instant in a 1 ms window. */
+    c->solver.instant_window = 1e-3;
+    recorder r = {0};
+    bk_sink sink = {&r, record_sample, record_transition};
+    bk_error err = {0};
+    assert_int_equal(bk_run(c, &sink, NULL, NULL, NULL, &err), BK_ERR_ZENO);
+    assert_non_null(strstr(err.message, "block 0"));
+    assert_non_null(strstr(err.message, "t = 0.6514"));
+    recorder_free(&r);
+    free_config(c);
+}
+
+/* A progress callback can stop a run. */
+static int stop_at_one_second(void *user, double t, double t_end)
+{
+    (void)user;
+    (void)t_end;
+    return t > 1.0;
+}
+
+static void test_interrupt(void **state)
+{
+    (void)state;
+    scene_spec spec = paper_case(0.5, BK_SPRING_LINEAR, 1e-8);
+    bk_config *c = make_config(&spec);
+    recorder r = {0};
+    bk_sink sink = {&r, record_sample, record_transition};
+    bk_error err = {0};
+    assert_int_equal(bk_run(c, &sink, NULL, stop_at_one_second, NULL, &err), BK_ERR_INTERRUPTED);
+    assert_true(r.last_t < 1.2);
+    recorder_free(&r);
+    free_config(c);
+}
+
+/* Rows: one per sample time plus one per transition instant, strictly increasing in time,
+ * the last at t_end. */
+static void test_rows(void **state)
+{
+    (void)state;
+    scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, 1e-8);
+    spec.interval = 0.01;
+    recorder r = {0};
+    bk_run_stats stats;
+    bk_error err = {0};
+    assert_int_equal(run_spec(&spec, &r, &stats, &err), BK_OK);
+    assert_false(r.time_decreased);
+    assert_int_equal(r.rows, 501 + r.n_transitions);
+    assert_int_equal(stats.rows, (long)r.rows);
+    assert_close(r.last_t, 5.0, 0.0, 0.0);
+    assert_close(stats.t_reached, 5.0, 0.0, 0.0);
+    recorder_free(&r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_case_a_linear),
+        cmocka_unit_test(test_case_b_linear),
+        cmocka_unit_test(test_case_c_linear),
+        cmocka_unit_test(test_case_a_tension_only),
+        cmocka_unit_test(test_case_b_tension_only),
+        cmocka_unit_test(test_case_c_tension_only),
+        cmocka_unit_test(test_case_a_paper_numbers),
+        cmocka_unit_test(test_error_shrinks_with_rtol),
+        cmocka_unit_test(test_case_c_hidden_stops),
+        cmocka_unit_test(test_no_refire_after_restart),
+        cmocka_unit_test(test_energy_two_blocks),
+        cmocka_unit_test(test_energy_ten_blocks),
+        cmocka_unit_test(test_simultaneous_transitions),
+        cmocka_unit_test(test_reversal),
+        cmocka_unit_test(test_chattering_guard),
+        cmocka_unit_test(test_interrupt),
+        cmocka_unit_test(test_rows),
+    };
+    return cmocka_run_group_tests_name("run", tests, NULL, NULL);
+}

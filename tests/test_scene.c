@@ -1,0 +1,157 @@
+/* The compact ODE: only slipping blocks are integrated, stateless laws carry no state, and
+ * every root function of a block that just switched starts clearly away from zero. */
+#include <stdint.h>
+#include <stdlib.h>
+
+#include "bk_test.h"
+#include "bksim/model.h"
+#include "scene.h"
+
+static bk_model *make_chain(size_t n, bk_spring spring)
+{
+    bk_model *m = bk_model_create(n);
+    assert_non_null(m);
+    m->coupling_stiffness = 2e4;
+    m->spring = spring;
+    m->driver.velocity = 1e-3;
+    for (size_t i = 0; i < n; ++i) {
+        m->blocks[i].mass = 1.0;
+        m->blocks[i].driver_stiffness = 1e4;
+        m->blocks[i].normal_force = 9.81;
+        m->blocks[i].law = &bk_friction_coulomb;
+        m->blocks[i].friction_params[0] = 0.6;
+        m->blocks[i].friction_params[1] = 0.5;
+    }
+    bk_model_finalize(m);
+    return m;
+}
+
+static void test_layout(void **state)
+{
+    (void)state;
+    bk_model *m = make_chain(4, BK_SPRING_LINEAR);
+    assert_int_equal(m->n_friction_state, 0); /* Coulomb carries no state */
+    bk_scene s;
+    assert_int_equal(bk_scene_init(&s, m, 1), 0);
+    s.mode[1] = BK_MODE_SLIP_POS;
+    s.mode[3] = BK_MODE_SLIP_NEG;
+    s.v[1] = 0.01;
+    s.v[3] = -0.02;
+    s.v[0] = 0.5; /* a stuck block's velocity is forced to zero */
+    double y[16];
+    bk_scene_restart(&s, 0.3, y);
+    assert_int_equal(s.n_y, 2 * 2 + 2); /* two slipping blocks, plus two energy increments */
+    assert_int_equal(s.n_active, 2);
+    assert_true(s.slot[0] == SIZE_MAX && s.slot[2] == SIZE_MAX);
+    assert_close(y[s.slot[1]], 0.0, 0, 0);
+    assert_close(y[s.slot[1] + 1], 0.01, 0, 0);
+    assert_close(y[s.slot[3] + 1], -0.02, 0, 0);
+    assert_close(s.v[0], 0.0, 0, 0);
+    /* Unpacking returns slip since the restart on top of the reference positions. */
+    y[s.slot[1]] = 2.5e-5;
+    bk_scene_unpack(&s, 0.31, y);
+    assert_close(s.x[1], 2.5e-5, 1e-15, 0);
+    assert_close(s.x[0], 0.0, 0, 0);
+    bk_scene_free(&s);
+    bk_model_free(m);
+}
+
+/* dv/dt of a slipping block is (applied force - s f_k) / m; energy rates match. */
+static void test_rhs(void **state)
+{
+    (void)state;
+    bk_model *m = make_chain(2, BK_SPRING_LINEAR);
+    bk_scene s;
+    assert_int_equal(bk_scene_init(&s, m, 1), 0);
+    s.x[0] = 1e-4;
+    s.x[1] = -2e-4;
+    s.mode[0] = BK_MODE_SLIP_POS;
+    s.v[0] = 3e-3;
+    double y[8], ydot[8];
+    bk_scene_restart(&s, 0.5, y);
+    bk_scene_rhs(0.5, y, ydot, &s);
+    double D = 0.5e-3;
+    double applied = 1e4 * (D - 1e-4) + 2e4 * (-2e-4 - 1e-4);
+    assert_close(ydot[s.slot[0]], 3e-3, 0, 0);
+    assert_close(ydot[s.slot[0] + 1], applied - 0.5 * 9.81, 1e-14, 0);
+    double driver_power = 1e-3 * (1e4 * (D - 1e-4) + 1e4 * (D + 2e-4));
+    assert_close(ydot[s.n_y - 2], driver_power, 1e-14, 0);
+    assert_close(ydot[s.n_y - 1], 0.5 * 9.81 * 3e-3, 1e-14, 0);
+    bk_scene_free(&s);
+    bk_model_free(m);
+}
+
+/* Right after a switch, each of the block's root functions is clearly non-zero, so a
+ * restarted integrator cannot see the handled root again. */
+static void test_roots_clear_of_zero_after_switch(void **state)
+{
+    (void)state;
+    const bk_spring springs[] = {BK_SPRING_LINEAR, BK_SPRING_TENSION_ONLY};
+    for (size_t sp = 0; sp < 2; ++sp) {
+        bk_model *m = make_chain(3, springs[sp]);
+        bk_scene s;
+        assert_int_equal(bk_scene_init(&s, m, 1), 0);
+        size_t R = s.roots_per_block;
+        double t = 0.7, D = 0.7e-3;
+        /* Block 1 just broke away at its threshold; block 2 just stopped below it. */
+        m->coupling_stiffness = 0.0;
+        s.x[1] = D - 0.6 * 9.81 / 1e4;          /* driver spring at mu_s N */
+        s.x[0] = s.x[2] = D - 0.3 * 9.81 / 1e4; /* at half their threshold */
+        s.mode[1] = BK_MODE_SLIP_POS;
+        s.t_switch[1] = t;
+        s.from_rest[1] = 1;
+        s.v[1] = 0.0;
+        double y[16], g[12];
+        bk_scene_restart(&s, t, y);
+        bk_scene_roots(t, y, g, &s);
+        double accel = (0.6 - 0.5) * 9.81;               /* (F_s - f_k) / m */
+        assert_close(g[R * 1 + BK_ROOT_MAIN], accel, 1e-9, 0); /* stop: s v / (t - t_switch) -> s a */
+        assert_close(g[R * 1 + BK_ROOT_EXTREMUM], accel, 1e-9, 0);
+        /* A moment later the stop function is s v / dt, still about s a. */
+        double ydot[16];
+        bk_scene_rhs(t, y, ydot, &s);
+        double y1[16];
+        for (size_t k = 0; k < s.n_y; ++k)
+            y1[k] = y[k] + 1e-9 * ydot[k];
+        bk_scene_roots(t + 1e-9, y1, g, &s);
+        assert_close(g[R * 1 + BK_ROOT_MAIN], accel, 1e-6, 0);
+        /* The stuck neighbours sit well inside their thresholds. */
+        assert_true(g[R * 0 + BK_ROOT_MAIN] > 0.1);
+        if (R > 2)
+            assert_true(g[R * 1 + BK_ROOT_SLACK] > 1e-4);
+        bk_scene_free(&s);
+        bk_model_free(m);
+    }
+}
+
+/* A slack tension-only spring stays slack in the right-hand side until the restart at the
+ * slack/taut root flips it: the integrator sees a smooth problem. */
+static void test_tension_only_frozen(void **state)
+{
+    (void)state;
+    bk_model *m = make_chain(1, BK_SPRING_TENSION_ONLY);
+    bk_scene s;
+    assert_int_equal(bk_scene_init(&s, m, 1), 0);
+    s.mode[0] = BK_MODE_SLIP_POS;
+    s.v[0] = 0.05;
+    s.x[0] = 1.2e-3; /* ahead of the driver at 1e-3: slack */
+    double y[8], ydot[8];
+    bk_scene_restart(&s, 1.0, y);
+    assert_int_equal(s.taut[0], 0);
+    y[s.slot[0]] = -0.5e-3; /* a trial state behind the driver: still treated as slack */
+    bk_scene_rhs(1.0, y, ydot, &s);
+    assert_close(ydot[s.slot[0] + 1], -0.5 * 9.81, 1e-14, 0);
+    bk_scene_free(&s);
+    bk_model_free(m);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_layout),
+        cmocka_unit_test(test_rhs),
+        cmocka_unit_test(test_roots_clear_of_zero_after_switch),
+        cmocka_unit_test(test_tension_only_frozen),
+    };
+    return cmocka_run_group_tests_name("scene", tests, NULL, NULL);
+}
