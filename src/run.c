@@ -357,6 +357,10 @@ static int integrate(run_ctx *ctx, double *t)
     bk_scene_restart(scene, *t, ctx->y);
     bk_scene_tolerances(scene, ctx->atol_x, ctx->atol_v, ctx->atol_state, ctx->atol_energy, ctx->atol);
     ctx->problem.half_bandwidth = scene->half_bandwidth;
+    /* Pairs lead the layout only when no friction state is interleaved. */
+    ctx->problem.n_pairs = ctx->model->n_friction_state == 0 ? scene->n_active : 0;
+    ctx->problem.pair_mass = scene->active_mass;
+    ctx->problem.affine = scene->affine;
     int rc = ctx->backend->start(ctx->solver, &ctx->problem, *t, ctx->y, ctx->atol, scene->n_y,
                                  ctx->t_end, ctx->err);
     if (rc != BK_OK)

@@ -39,19 +39,25 @@ int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
     scene->slot = calloc(n, sizeof *scene->slot);
     scene->state_slot = calloc(n, sizeof *scene->state_slot);
     scene->active = calloc(n, sizeof *scene->active);
+    scene->active_mass = calloc(n, sizeof *scene->active_mass);
     scene->stateful = calloc(n, sizeof *scene->stateful);
     scene->left = calloc(n, sizeof *scene->left);
     scene->right = calloc(n, sizeof *scene->right);
     scene->root_direction = calloc(n * scene->roots_per_block, sizeof *scene->root_direction);
     if (!scene->mode || !scene->x_ref || !scene->x || !scene->v || !scene->state ||
         !scene->normal || !scene->t_switch || !scene->from_rest || !scene->taut || !scene->slot ||
-        !scene->state_slot || !scene->active || !scene->stateful || !scene->left ||
+        !scene->state_slot || !scene->active || !scene->active_mass || !scene->stateful || !scene->left ||
         !scene->right || !scene->root_direction) {
         bk_scene_free(scene);
         return -1;
     }
+    /* Stateless constant-force laws and a constant-velocity driver make every frozen-mode
+     * segment linear with constant coefficients. */
+    scene->affine = model->n_friction_state == 0;
     for (size_t i = 0; i < n; ++i) {
         const bk_block *b = &model->blocks[i];
+        if (!(b->law->flags & BK_FRICTION_CONSTANT_SLIDING))
+            scene->affine = 0;
         scene->normal[i] = b->normal_force;
         scene->x[i] = scene->x_ref[i] = b->x_init;
         scene->v[i] = b->v_init;
@@ -78,6 +84,7 @@ void bk_scene_free(bk_scene *scene)
     free(scene->slot);
     free(scene->state_slot);
     free(scene->active);
+    free(scene->active_mass);
     free(scene->stateful);
     free(scene->left);
     free(scene->right);
@@ -143,6 +150,7 @@ void bk_scene_restart(bk_scene *scene, double t, double *y)
                           bk_driver_velocity(&model->driver, t) - (dir != 0 ? scene->v[i] : 0.0) > 0.0);
         if (dir != 0) {
             scene->slot[i] = next;
+            scene->active_mass[scene->n_active] = b->mass;
             scene->active[scene->n_active++] = i;
             y[next] = 0.0;
             y[next + 1] = scene->v[i];

@@ -47,6 +47,8 @@ typedef struct bk_scene {
     double stuck_taut_stiffness; /* N/m, sum of k_i over stuck blocks with a taut driver spring */
     double stuck_force_ref;      /* N, their driver-spring forces at t_ref */
     size_t *active;          /* the n_active slipping blocks, chain order */
+    double *active_mass;     /* kg, their masses in the same order */
+    int affine;              /* the compact ODE is affine in y and t (see bk_ode_problem) */
     size_t *stateful;        /* blocks whose law carries state */
     size_t n_stateful;
     long *left, *right;      /* coupling partners (bk_model_neighbours) */

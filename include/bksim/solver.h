@@ -20,6 +20,14 @@ typedef struct bk_ode_problem {
     size_t n_roots;
     const int *root_direction; /* n_roots: +1 rising only, -1 falling only, 0 both */
     size_t half_bandwidth;     /* Jacobian bandwidth each side, for band solvers */
+    /* Structure, for back-ends that exploit it (the exact stepper).  y starts with n_pairs
+     * (position, velocity) pairs; the rest are quadratures (their derivatives do not depend
+     * on themselves).  When affine is set, y' = A y + b0 + b1 t exactly, accelerations do
+     * not depend on velocities, and pair_mass[k] is the mass of pair k (kg), so that
+     * M^(1/2) (d accel / d position) M^(-1/2) is symmetric. */
+    size_t n_pairs;
+    const double *pair_mass;
+    int affine;
 } bk_ode_problem;
 
 typedef struct bk_solver_counters {
