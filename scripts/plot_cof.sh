@@ -20,7 +20,7 @@ plot '$tmp/$k.dat' using 1:2 with lines lc rgb '$color' lw 1.5 title '$label'"
 done
 
 gnuplot <<GP
-set terminal pngcairo size 1200,800 font 'Sans,13'
+set terminal pngcairo size 1200,800 font 'Sans,13' noenhanced
 set output '$out'
 set multiplot layout $#,1 title '$title'
 set grid

@@ -25,7 +25,7 @@ for spec in "$@"; do
 done
 
 gnuplot <<GP
-set terminal pngcairo size 1200,800 font 'Sans,13'
+set terminal pngcairo size 1200,800 font 'Sans,13' noenhanced
 set output '$out'
 set multiplot layout 2,1 title '$title'
 set grid

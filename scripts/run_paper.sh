@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# The main job: every paper config, its HDF5 file and its figures under out/paper/, and a
-# text summary per case (out/paper/summary.txt).
+# The main job: every paper config, its HDF5 file and the paper's Figures 2 and 4-9 under
+# out/paper/, and a one-line summary per case (out/paper/summary.txt).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bksim=${BKSIM:-./bksim}
 out=out/paper
 mkdir -p "$out"
+rm -f "$out"/*.png "$out"/*.h5 "$out"/*.part
 
 for config in configs/paper/*.ini; do
     name=$(basename "$config" .ini)
@@ -13,18 +14,27 @@ for config in configs/paper/*.ini; do
     echo "ran $config -> $out/$name.h5"
 done
 
+scripts/plot_fig2.sh "$out/fig2_velocity_step.png" "$out/fig2_velocity_step.h5"
+fig=4
 for c in a b c; do
     C=$(echo "$c" | tr a-z A-Z)
-    scripts/plot_kinematics.sh "$out/case_${c}_kinematics.png" \
-        "Case $C: position and velocity (Coulomb, linear spring)" \
-        "$out/case_${c}_coulomb.h5:Coulomb:black"
-    scripts/plot_cof.sh "$out/case_${c}_cof.png" "Case $C: apparent COF (Coulomb, linear spring)" \
-        "$out/case_${c}_coulomb.h5:Coulomb:black"
+    mu=$(awk -F'[=;]' '$1 ~ /^mu_d/ {gsub(/ /, "", $2); print $2}' "configs/paper/case_${c}_coulomb.ini")
+    scripts/plot_kinematics.sh "$out/fig${fig}_case_${c}_kinematics.png" \
+        "Figure $fig: case $C (mu_d = $mu), position and velocity of block and driver" \
+        "$out/case_${c}_coulomb.h5:Coulomb:black" "$out/case_${c}_rs.h5:rate-and-state:red"
+    scripts/plot_cof.sh "$out/fig$((fig + 1))_case_${c}_cof.png" \
+        "Figure $((fig + 1)): case $C (mu_d = $mu), apparent COF (friction / normal force)" \
+        "$out/case_${c}_coulomb.h5:Coulomb:black" "$out/case_${c}_rs.h5:rate-and-state:red"
+    fig=$((fig + 2))
 done
+# What the tension-only spring (the paper's text) changes in case A.
 scripts/plot_kinematics.sh "$out/case_a_tension_only_kinematics.png" \
-    "Case A: linear vs tension-only driver spring (Coulomb)" \
-    "$out/case_a_coulomb.h5:linear spring:black" \
-    "$out/case_a_coulomb_tension_only.h5:tension-only spring:#1f77b4"
+    "Case A with a tension-only driver spring (the twins of Figure 4)" \
+    "$out/case_a_coulomb_tension_only.h5:Coulomb:black" "$out/case_a_rs_tension_only.h5:rate-and-state:red"
+scripts/plot_cof.sh "$out/case_a_tension_only_cof.png" \
+    "Case A with a tension-only driver spring (the twins of Figure 5)" \
+    "$out/case_a_coulomb_tension_only.h5:Coulomb:black" "$out/case_a_rs_tension_only.h5:rate-and-state:red"
 
-scripts/summary.sh "$out"/*.h5 | tee "$out/summary.txt"
-echo "figures: $(ls "$out"/*.png | tr '\n' ' ')"
+scripts/summary.sh "$out"/case_*.h5 | tee "$out/summary.txt"
+echo "figures:"
+ls "$out"/*.png

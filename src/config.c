@@ -31,7 +31,7 @@
 
 /* --- the key table ---------------------------------------------------------------------- */
 
-typedef enum key_type { KEY_DOUBLE, KEY_INT, KEY_BOOL, KEY_ENUM, KEY_STRING, KEY_FIELDS } key_type;
+typedef enum key_type { KEY_DOUBLE, KEY_INT, KEY_BOOL, KEY_ENUM, KEY_STRING, KEY_FIELDS, KEY_LIST } key_type;
 
 static const char *const boundary_names[] = {"free", "fixed", "periodic", NULL};
 static const char *const spring_names[] = {"linear", "tension_only", NULL};
@@ -127,11 +127,20 @@ static const key_def keys[] = {
     {"output", {"transitions", "", 1, 0, 1, 0, "write the /transitions table"}, KEY_BOOL, NULL, NULL, "true"},
     {"output", {"event_rows", "", 1, 0, 1, 0, "add a row at every transition instant"}, KEY_BOOL, NULL, NULL, "true"},
 
-    NUM("run", "t_end", "s", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE, "end time (runs from 0)"),
+    NUM("run", "t_end", "s", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE,
+        "end time (runs from 0); in a prescribed scene optional, at most the schedule's length"),
+
+    {"prescribed", {"slip_rates", "m/s", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED,
+                    "slip rate of each segment, in order (0: a hold)"}, KEY_LIST, NULL, NULL, NULL},
+    {"prescribed", {"durations", "s", NAN, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
+                    "duration of each segment (give durations or distances)"}, KEY_LIST, NULL, NULL, "-"},
+    {"prescribed", {"distances", "m", NAN, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
+                    "slip distance of each segment (not for holds)"}, KEY_LIST, NULL, NULL, "-"},
 };
 #define N_KEYS (sizeof keys / sizeof keys[0])
 
-static const char *const sections[] = {"model", "block", "friction", "driver", "solver", "output", "run", NULL};
+static const char *const sections[] = {"model", "block", "friction", "driver", "solver", "output", "run",
+                                       "prescribed", NULL};
 
 static const key_def *find_key(const char *section, const char *key)
 {
@@ -159,7 +168,8 @@ typedef struct entry {
     const char *override;      /* the --set text, or NULL */
     long rank;                 /* position for "first error" */
     int superseded;            /* replaced by a later override */
-    double number;             /* parsed value (numbers, bools, enum index) */
+    double number;             /* parsed value (numbers, bools, enum index, list length) */
+    double *list;              /* KEY_LIST values, owned */
 } entry;
 
 typedef struct loader {
@@ -325,6 +335,12 @@ static int on_pair(void *user, const char *section, const char *key, const char 
 
 static void format_allowed(const key_def *def, const bk_param *param, char *buf, size_t len)
 {
+    if (def && def->type == KEY_LIST) {
+        char range[256];
+        bk_param_format_range(param, range, sizeof range);
+        snprintf(buf, len, "numbers separated by commas or spaces, each %s", range);
+        return;
+    }
     if (!def || def->type == KEY_DOUBLE || def->type == KEY_INT) {
         bk_param_format_range(param, buf, len);
         if (def && def->type == KEY_INT) {
@@ -479,6 +495,45 @@ static int check_value(loader *ld, entry *e, const key_def *def, const bk_param 
             return -1;
         }
         return 0;
+    case KEY_LIST: {
+        size_t count = 0, cap = 8;
+        e->list = malloc(cap * sizeof *e->list);
+        const char *p = v;
+        while (e->list) {
+            while (*p == ',' || isspace((unsigned char)*p))
+                ++p;
+            if (!*p)
+                break;
+            const char *start = p;
+            while (*p && *p != ',' && !isspace((unsigned char)*p))
+                ++p;
+            char word[64];
+            snprintf(word, sizeof word, "%.*s", (int)(p - start), start);
+            double x;
+            if (parse_number(word, &x) || !bk_param_in_range(param, x)) {
+                report_entry(ld, e, "bad value \"%s\" (item %zu) (allowed: %s)", word, count + 1, allowed);
+                return -1;
+            }
+            if (count == cap) {
+                double *grown = realloc(e->list, 2 * cap * sizeof *grown);
+                if (!grown)
+                    break;
+                e->list = grown;
+                cap *= 2;
+            }
+            e->list[count++] = x;
+        }
+        if (!e->list) {
+            ld->oom = 1;
+            return -1;
+        }
+        if (count == 0) {
+            report_entry(ld, e, "empty list (allowed: %s)", allowed);
+            return -1;
+        }
+        e->number = (double)count;
+        return 0;
+    }
     case KEY_FIELDS: {
         char bad[64];
         if (parse_fields(v, &e->number, bad, sizeof bad)) {
@@ -694,20 +749,17 @@ static char *default_output_path(const char *name)
     return path;
 }
 
-/* Everything checked: build the config.  Reports missing and cross-key errors. */
-static bk_config *build(loader *ld)
+/* The chain: model, blocks, friction, driver. */
+static void build_chain(loader *ld, bk_config *c)
 {
-    bk_config *c = calloc(1, sizeof *c);
-    if (!c)
-        return NULL;
     double n_value = value_of(ld, "model", "n_blocks");
     if (!(n_value >= 1))
-        return c; /* reported */
+        return; /* reported */
     size_t n = (size_t)n_value;
     bk_model *m = bk_model_create(n);
     if (!m) {
         report(ld, 0, BK_ERR_NOMEM, "%s: out of memory for %zu blocks", ld->name, n);
-        return c;
+        return;
     }
     c->model = m;
     m->boundary = (bk_boundary)(int)value_of(ld, "model", "boundary");
@@ -740,6 +792,97 @@ static bk_config *build(loader *ld)
             break; /* one missing key is enough; don't repeat it for every block */
     }
     bk_model_finalize(m);
+    c->t_end = value_of(ld, "run", "t_end");
+}
+
+/* A prescribed-motion scene: the schedule and one block's friction.  The chain's keys are
+ * optional here: normal_force defaults to mass * gravity, or 1 N without a mass. */
+static void build_prescribed(loader *ld, bk_config *c)
+{
+    entry *rates = lookup(ld, "prescribed", "slip_rates");
+    entry *durations = lookup(ld, "prescribed", "durations");
+    entry *distances = lookup(ld, "prescribed", "distances");
+    if (!rates) {
+        report_missing(ld, "prescribed", &find_key("prescribed", "slip_rates")->param,
+                       find_key("prescribed", "slip_rates"));
+        return;
+    }
+    if (!durations == !distances) {
+        report_entry(ld, durations ? distances : rates, "give exactly one of durations and distances");
+        return;
+    }
+    entry *lengths = durations ? durations : distances;
+    size_t n = (size_t)rates->number;
+    if ((size_t)lengths->number != n) {
+        report_entry(ld, lengths, "has %zu values, slip_rates has %zu", (size_t)lengths->number, n);
+        return;
+    }
+    entry *n_blocks = lookup(ld, "model", "n_blocks");
+    if (n_blocks && n_blocks->number != 1.0)
+        report_entry(ld, n_blocks, "a prescribed scene has one block, got %s", n_blocks->value);
+    bk_prescribed *pr = calloc(1, sizeof *pr);
+    bk_model *m = bk_model_create(1);
+    if (pr) {
+        pr->slip_rate = calloc(n, sizeof *pr->slip_rate);
+        pr->duration = calloc(n, sizeof *pr->duration);
+    }
+    c->prescribed = pr;
+    c->model = m;
+    if (!pr || !pr->slip_rate || !pr->duration || !m) {
+        report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+        return;
+    }
+    pr->n_segments = n;
+    double total = 0.0, first_rate = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+        double rate = rates->list[k];
+        pr->slip_rate[k] = rate;
+        if (distances && rate == 0.0) {
+            report_entry(ld, distances, "segment %zu is a hold (slip rate 0): give durations", k + 1);
+            return;
+        }
+        pr->duration[k] = durations ? durations->list[k] : distances->list[k] / rate;
+        total += pr->duration[k];
+        if (first_rate == 0.0)
+            first_rate = rate;
+    }
+    m->gravity = value_of(ld, "model", "gravity");
+    m->driver.velocity = first_rate;
+    bk_block *b = &m->blocks[0];
+    int given_mass, given_normal;
+    double mass = block_value(ld, 0, "mass", &given_mass);
+    b->mass = given_mass ? mass : 1.0;
+    b->normal_force = block_value(ld, 0, "normal_force", &given_normal);
+    if (!given_normal)
+        b->normal_force = given_mass ? b->mass * m->gravity : 1.0;
+    build_friction(ld, b, 0, first_rate);
+    bk_model_finalize(m);
+    entry *t_end = lookup(ld, "run", "t_end");
+    c->t_end = total;
+    if (t_end && t_end->number <= total * (1 + 1e-12))
+        c->t_end = t_end->number;
+    else if (t_end)
+        report_entry(ld, t_end, "must be <= the schedule's length (%.10g s), got %s", total, t_end->value);
+}
+
+static int has_section(loader *ld, const char *section)
+{
+    for (size_t i = 0; i < ld->n; ++i)
+        if (!ld->entries[i].superseded && strcmp(ld->entries[i].base, section) == 0)
+            return 1;
+    return 0;
+}
+
+/* Everything checked: build the config.  Reports missing and cross-key errors. */
+static bk_config *build(loader *ld)
+{
+    bk_config *c = calloc(1, sizeof *c);
+    if (!c)
+        return NULL;
+    if (has_section(ld, "prescribed"))
+        build_prescribed(ld, c);
+    else
+        build_chain(ld, c);
 
     bk_solver_options *s = &c->solver;
     snprintf(s->method, sizeof s->method, "%s", method_name((size_t)value_of(ld, "solver", "method")));
@@ -754,7 +897,6 @@ static bk_config *build(loader *ld)
     s->max_transitions_per_instant = (long)value_of(ld, "solver", "max_transitions_per_instant");
     s->instant_window = value_of(ld, "solver", "instant_window");
 
-    c->t_end = value_of(ld, "run", "t_end");
     bk_output_options *o = &c->output;
     entry *path = lookup(ld, "output", "path");
     o->path = path ? strdup(path->value) : default_output_path(ld->name);
@@ -765,6 +907,8 @@ static bk_config *build(loader *ld)
     if (interval && isfinite(c->t_end) && interval->number > c->t_end)
         report_entry(ld, interval, "must be <= t_end (%g s), got %s", c->t_end, interval->value);
     o->fields = (unsigned)value_of(ld, "output", "fields");
+    if (c->prescribed)
+        o->fields &= ~(unsigned)BK_FIELD_ENERGY; /* no dynamics, no energies */
     o->transitions = (int)value_of(ld, "output", "transitions");
     o->event_rows = (int)value_of(ld, "output", "event_rows");
     return c;
@@ -777,6 +921,11 @@ void bk_config_free(bk_config *config)
     if (!config)
         return;
     bk_model_free(config->model);
+    if (config->prescribed) {
+        free(config->prescribed->slip_rate);
+        free(config->prescribed->duration);
+        free(config->prescribed);
+    }
     free(config->output.path);
     free(config->source_name);
     free(config->text);
@@ -785,8 +934,10 @@ void bk_config_free(bk_config *config)
 
 static void free_loader(loader *ld)
 {
-    for (size_t i = 0; i < ld->n; ++i)
+    for (size_t i = 0; i < ld->n; ++i) {
         free(ld->entries[i].value);
+        free(ld->entries[i].list);
+    }
     free(ld->entries);
 }
 
@@ -956,6 +1107,10 @@ void bk_config_write_reference(FILE *out)
         "solver", "Integration.",
         "output", "The HDF5 file.",
         "run", "The time span.",
+        "prescribed", "A prescribed-motion scene instead of the chain's dynamics (paper Figure 2, slide-hold-slide): "
+                      "one block slides at a piecewise-constant slip rate and its friction state follows the law's "
+                      "exact evolution. The presence of this section selects it; `[model]`, `[block]` and `[driver]` "
+                      "keys are then optional (normal_force defaults to mass * gravity, or 1 N without a mass).",
     };
     fprintf(out, "Units are SI. Keys are case-sensitive; `;` starts a comment (also after a value).\n");
     for (size_t s = 0; sections[s]; ++s) {

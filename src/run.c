@@ -24,6 +24,7 @@
 #include <gsl/gsl_roots.h>
 
 #include "bksim/solver.h"
+#include "prescribed.h"
 #include "scene.h"
 
 #define NO_SLOT SIZE_MAX
@@ -255,28 +256,36 @@ static int locate_hidden_stop(run_ctx *ctx, size_t i, double t_root, double *t_s
     return probe.status;
 }
 
-enum { ROOT_CONTINUE = 0, ROOT_RESTART = 1 };
-
-/* Handle a root reported at t_root with state y.  Emits the samples before the event, the
- * transitions and the event row; sets *t_event.  Returns ROOT_CONTINUE when no block
- * changed and the integrator may go on, ROOT_RESTART otherwise, or < 0. */
-static int handle_root(run_ctx *ctx, double t_root, double *t_event)
+/* Handle a root reported at t_root with state y (from_root), or a step end where a
+ * slipping block's velocity is found past zero although no root fired (a stop the root
+ * functions could not see, e.g. one masked at a restart).  Emits the samples before the
+ * event, the transitions and the event row; sets *t_event.  Returns 0, or < 0 on failure;
+ * the caller restarts the integrator at *t_event. */
+static int handle_root(run_ctx *ctx, double t_root, int from_root, double *t_event)
 {
     bk_scene *scene = &ctx->scene;
     size_t n = scene->n, R = scene->roots_per_block;
-    int rc = ctx->backend->root_info(ctx->solver, ctx->found);
-    if (rc != BK_OK)
-        return BK_FAIL(ctx->err, BK_ERR_SOLVER, "cannot read root information at t = %.17g s", t_root);
+    if (from_root) {
+        int rc = ctx->backend->root_info(ctx->solver, ctx->found);
+        if (rc != BK_OK)
+            return BK_FAIL(ctx->err, BK_ERR_SOLVER, "cannot read root information at t = %.17g s", t_root);
+    } else {
+        memset(ctx->found, 0, n * R * sizeof *ctx->found);
+    }
     bk_scene_unpack(scene, t_root, ctx->y);
+    int rc;
 
-    /* A slip-rate minimum below zero: the stop hid inside the step. */
+    /* A slip-rate minimum below zero, or a velocity past zero at a step end: the stop hid
+     * inside the step. */
     double t_hidden = t_root;
     size_t hidden_block = SIZE_MAX;
     for (size_t i = 0; i < n; ++i) {
-        if (scene->slot[i] == NO_SLOT || !ctx->found[R * i + BK_ROOT_EXTREMUM] ||
-            ctx->found[R * i + BK_ROOT_MAIN])
+        if (scene->slot[i] == NO_SLOT || !scene->can_stick[i] || ctx->found[R * i + BK_ROOT_MAIN])
             continue;
-        if ((double)scene->mode[i] * scene->v[i] > 0.0)
+        if (from_root && !ctx->found[R * i + BK_ROOT_EXTREMUM])
+            continue;
+        double slip_rate = (double)scene->mode[i] * scene->v[i];
+        if (from_root ? slip_rate > 0.0 : slip_rate >= 0.0)
             continue;
         double t_stop = t_root;
         if ((rc = locate_hidden_stop(ctx, i, t_root, &t_stop)) != BK_OK)
@@ -287,18 +296,13 @@ static int handle_root(run_ctx *ctx, double t_root, double *t_event)
         }
     }
 
-    int need_restart = 0;
-    double t = t_root;
-    if (hidden_block != SIZE_MAX) {
-        t = t_hidden;
-        need_restart = 1;
-    } else {
-        for (size_t i = 0; i < n && !need_restart; ++i)
-            need_restart = ctx->found[R * i + BK_ROOT_MAIN] != 0 ||
-                           (R > 2 && ctx->found[R * i + BK_ROOT_SLACK] != 0);
-    }
-    if (!need_restart)
-        return ROOT_CONTINUE;
+    double t = hidden_block != SIZE_MAX ? t_hidden : t_root;
+    /* Every root restarts the integrator.  A minimum that hid no stop disarms its root until
+     * the block decelerates again, so the restart does not begin on a zero of it. */
+    if (hidden_block == SIZE_MAX)
+        for (size_t i = 0; i < n; ++i)
+            if (ctx->found[R * i + BK_ROOT_EXTREMUM])
+                scene->extremum_armed[i] = 0;
 
     /* Samples strictly before the event, then the state at the event itself. */
     if ((rc = emit_interpolated(ctx, t, 0)) != BK_OK)
@@ -331,7 +335,19 @@ static int handle_root(run_ctx *ctx, double t_root, double *t_event)
         skip_sample_at(ctx, t);
     }
     *t_event = t;
-    return ROOT_RESTART;
+    return BK_OK;
+}
+
+/* A slipping block whose velocity is past zero at a step end without a root. */
+static int missed_stop(const run_ctx *ctx)
+{
+    const bk_scene *scene = &ctx->scene;
+    for (size_t k = 0; k < scene->n_active; ++k) {
+        size_t i = scene->active[k];
+        if (scene->can_stick[i] && (double)scene->mode[i] * ctx->y[scene->slot[i] + 1] < 0.0)
+            return 1;
+    }
+    return 0;
 }
 
 static int check_finite(run_ctx *ctx, double t)
@@ -381,17 +397,18 @@ static int integrate(run_ctx *ctx, double *t)
                            ctx->options.max_steps, ctx->t_last_row, t_reached);
         if (step == BK_STEP_ROOT) {
             double t_event = t_reached;
-            int action = handle_root(ctx, t_reached, &t_event);
-            if (action < 0)
-                return action;
-            if (action == ROOT_RESTART) {
-                *t = t_event;
-                return report_progress(ctx, *t);
-            }
-            /* A root that changes nothing: the step's samples up to the root are still due. */
-            if ((rc = emit_interpolated(ctx, t_reached, 1)) != BK_OK)
+            if ((rc = handle_root(ctx, t_reached, 1, &t_event)) != BK_OK)
                 return rc;
-            continue;
+            *t = t_event;
+            return report_progress(ctx, *t);
+        }
+        bk_scene_arm(scene, t_reached, ctx->y);
+        if (missed_stop(ctx)) {
+            double t_event = t_reached;
+            if ((rc = handle_root(ctx, t_reached, 0, &t_event)) != BK_OK)
+                return rc;
+            *t = t_event;
+            return report_progress(ctx, *t);
         }
         if ((rc = emit_interpolated(ctx, t_reached, 1)) != BK_OK)
             return rc;
@@ -529,9 +546,9 @@ static void resolve_scales(run_ctx *ctx)
     for (size_t i = 0; i < model->n_blocks; ++i) {
         double stiffness = model->blocks[i].driver_stiffness +
                            bk_model_coupling_count(model, i) * model->coupling_stiffness;
-        double threshold = ctx->scene.model->blocks[i].law->flags & BK_FRICTION_STATIC_THRESHOLD
-                               ? bk_scene_static_threshold(&ctx->scene, i)
-                               : bk_scene_sliding_force(&ctx->scene, i, 0.0);
+        double driver_speed = fabs(model->driver.velocity) > 0.0 ? fabs(model->driver.velocity) : 1e-3;
+        double threshold = ctx->scene.can_stick[i] ? bk_scene_static_threshold(&ctx->scene, i)
+                                                   : fabs(bk_scene_sliding_force(&ctx->scene, i, driver_speed));
         if (threshold > force)
             force = threshold;
         if (stiffness > 0.0 && threshold / stiffness > length)
@@ -549,7 +566,10 @@ static void resolve_scales(run_ctx *ctx)
                                                              : 1e-3;
     ctx->atol_x = isnan(opt->atol_x) ? opt->rtol * 1e-3 * length : opt->atol_x;
     ctx->atol_v = isnan(opt->atol_v) ? opt->rtol * 1e-3 * velocity_scale : opt->atol_v;
-    ctx->atol_state = opt->rtol * 1e-3;
+    double state_scale = 0.0;
+    for (size_t k = 0; k < model->n_friction_state; ++k)
+        state_scale = fmax(state_scale, fabs(ctx->scene.state[k]));
+    ctx->atol_state = opt->rtol * 1e-3 * (state_scale > 0.0 ? state_scale : 1.0);
     ctx->atol_energy = ctx->atol_x * force;
     if (isnan(opt->max_step))
         opt->max_step = isfinite(period) ? period / 8.0 : 0.0;
@@ -579,6 +599,11 @@ static int initial_modes(run_ctx *ctx, int *any_transition)
     bk_scene *scene = &ctx->scene;
     *any_transition = 0;
     for (size_t i = 0; i < scene->n; ++i) {
+        if (!scene->can_stick[i]) {
+            scene->mode[i] = scene->v[i] < 0.0 ? BK_MODE_SLIP_NEG : BK_MODE_SLIP_POS;
+            scene->from_rest[i] = 0;
+            continue;
+        }
         if (scene->v[i] != 0.0) {
             scene->mode[i] = scene->v[i] > 0.0 ? BK_MODE_SLIP_POS : BK_MODE_SLIP_NEG;
             scene->from_rest[i] = 0;
@@ -603,6 +628,8 @@ static double wall_seconds(void)
 int bk_run(const bk_config *config, const bk_sink *sink, bk_run_stats *stats,
            bk_progress_fn progress, void *progress_user, bk_error *err)
 {
+    if (config->prescribed)
+        return bk_run_prescribed(config, sink, stats, progress, progress_user, err);
     double wall0 = wall_seconds();
     clock_t cpu0 = clock();
     gsl_set_error_handler_off();

@@ -36,6 +36,8 @@ int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
     scene->t_switch = calloc(n, sizeof *scene->t_switch);
     scene->from_rest = calloc(n, sizeof *scene->from_rest);
     scene->taut = calloc(n, sizeof *scene->taut);
+    scene->can_stick = calloc(n, sizeof *scene->can_stick);
+    scene->extremum_armed = calloc(n, sizeof *scene->extremum_armed);
     scene->slot = calloc(n, sizeof *scene->slot);
     scene->state_slot = calloc(n, sizeof *scene->state_slot);
     scene->active = calloc(n, sizeof *scene->active);
@@ -45,7 +47,7 @@ int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
     scene->right = calloc(n, sizeof *scene->right);
     scene->root_direction = calloc(n * scene->roots_per_block, sizeof *scene->root_direction);
     if (!scene->mode || !scene->x_ref || !scene->x || !scene->v || !scene->state ||
-        !scene->normal || !scene->t_switch || !scene->from_rest || !scene->taut || !scene->slot ||
+        !scene->normal || !scene->t_switch || !scene->from_rest || !scene->taut || !scene->can_stick || !scene->extremum_armed || !scene->slot ||
         !scene->state_slot || !scene->active || !scene->active_mass || !scene->stateful || !scene->left ||
         !scene->right || !scene->root_direction) {
         bk_scene_free(scene);
@@ -59,6 +61,7 @@ int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
         if (!(b->law->flags & BK_FRICTION_CONSTANT_SLIDING))
             scene->affine = 0;
         scene->normal[i] = b->normal_force;
+        scene->can_stick[i] = (b->law->flags & BK_FRICTION_STATIC_THRESHOLD) != 0;
         scene->x[i] = scene->x_ref[i] = b->x_init;
         scene->v[i] = b->v_init;
         bk_model_neighbours(model, i, &scene->left[i], &scene->right[i]);
@@ -81,6 +84,8 @@ void bk_scene_free(bk_scene *scene)
     free(scene->t_switch);
     free(scene->from_rest);
     free(scene->taut);
+    free(scene->can_stick);
+    free(scene->extremum_armed);
     free(scene->slot);
     free(scene->state_slot);
     free(scene->active);
@@ -171,8 +176,8 @@ void bk_scene_restart(bk_scene *scene, double t, double *y)
             if (ns > max_state)
                 max_state = ns;
         }
-        scene->root_direction[R * i + BK_ROOT_MAIN] = -1;
-        scene->root_direction[R * i + BK_ROOT_EXTREMUM] = dir != 0 ? +1 : 0;
+        scene->root_direction[R * i + BK_ROOT_MAIN] = scene->can_stick[i] ? -1 : 0;
+        scene->root_direction[R * i + BK_ROOT_EXTREMUM] = dir != 0 && scene->can_stick[i] ? +1 : 0;
         if (R > 2)
             scene->root_direction[R * i + BK_ROOT_SLACK] = 0;
     }
@@ -183,6 +188,12 @@ void bk_scene_restart(bk_scene *scene, double t, double *y)
     scene->t_ref = t;
     scene->work_ref = scene->work;
     scene->dissipation_ref = scene->dissipation;
+    for (size_t k = 0; k < scene->n_active; ++k) {
+        size_t i = scene->active[k];
+        if (scene->from_rest[i] && scene->t_switch[i] == t)
+            scene->extremum_armed[i] = 0;
+    }
+    bk_scene_arm(scene, t, y);
 }
 
 void bk_scene_tolerances(const bk_scene *scene, double atol_x, double atol_v, double atol_state,
@@ -214,6 +225,9 @@ void bk_scene_unpack(bk_scene *scene, double t, const double *y)
         } else {
             scene->x[i] = scene->x_ref[i] + y[s];
             scene->v[i] = y[s + 1];
+            /* A block that cannot stick reports the way it moves (its law is odd in v). */
+            if (!scene->can_stick[i] && scene->v[i] != 0.0)
+                scene->mode[i] = (int8_t)(scene->v[i] > 0.0 ? BK_MODE_SLIP_POS : BK_MODE_SLIP_NEG);
         }
     }
     for (size_t k = 0; k < scene->n_stateful; ++k) {
@@ -274,7 +288,10 @@ int bk_scene_roots(double t, const double *y, double *g, void *user)
         double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(scene, y, i, x_i);
         const double *state = block_state(scene, y, i);
         size_t s = scene->slot[i];
-        if (s == NO_SLOT) {
+        if (!scene->can_stick[i]) {
+            gi[BK_ROOT_MAIN] = 1.0; /* smooth through v = 0: nothing to locate */
+            gi[BK_ROOT_EXTREMUM] = 1.0;
+        } else if (s == NO_SLOT) {
             gi[BK_ROOT_MAIN] = b->law->static_threshold(b->friction_params, scene->normal[i], state) -
                                fabs(applied);
             gi[BK_ROOT_EXTREMUM] = 1.0;
@@ -288,12 +305,40 @@ int bk_scene_roots(double t, const double *y, double *g, void *user)
                 gi[BK_ROOT_MAIN] = dir * v_i;
             else
                 gi[BK_ROOT_MAIN] = since > 0.0 ? dir * v_i / since : slip_accel;
-            gi[BK_ROOT_EXTREMUM] = scene->detect_extrema ? slip_accel : 1.0;
+            gi[BK_ROOT_EXTREMUM] = scene->detect_extrema && scene->extremum_armed[i] ? slip_accel : 1.0;
         }
         if (R > 2)
             gi[BK_ROOT_SLACK] = driver_pos - x_i;
     }
     return 0;
+}
+
+double bk_scene_slip_acceleration(const bk_scene *scene, size_t i, double t, const double *y)
+{
+    const bk_block *b = &scene->model->blocks[i];
+    size_t s = scene->slot[i];
+    double driver_pos = bk_driver_position(&scene->model->driver, t);
+    double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
+    double dir = (double)scene->mode[i];
+    double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(scene, y, i, x_i);
+    double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
+                                            block_state(scene, y, i));
+    return dir * (applied - dir * friction) / b->mass;
+}
+
+void bk_scene_arm(bk_scene *scene, double t, const double *y)
+{
+    for (size_t k = 0; k < scene->n_active; ++k) {
+        size_t i = scene->active[k];
+        if (scene->extremum_armed[i] || !scene->can_stick[i])
+            continue;
+        const bk_block *b = &scene->model->blocks[i];
+        double threshold = b->law->static_threshold(b->friction_params, scene->normal[i],
+                                                    block_state(scene, y, i));
+        /* Clearly negative: well beyond the rounding of (force - friction) / m. */
+        if (bk_scene_slip_acceleration(scene, i, t, y) < -1e-9 * threshold / b->mass)
+            scene->extremum_armed[i] = 1;
+    }
 }
 
 double bk_scene_applied_force(const bk_scene *scene, size_t i, double driver_pos)

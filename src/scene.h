@@ -33,7 +33,13 @@ typedef struct bk_scene {
                                 between restarts, like the slip direction, so the right-hand
                                 side stays smooth and the slack root is located on a smooth
                                 solution; the restart at that root flips it. */
-    int detect_extrema;      /* arm the slip-rate minimum roots */
+    int detect_extrema;      /* use the slip-rate minimum roots */
+    uint8_t *can_stick;      /* the block's law has a static threshold */
+    uint8_t *extremum_armed; /* the slip-rate minimum root is live.  A minimum only follows
+                                a deceleration, so the root is armed once s a is seen
+                                clearly negative and disarmed at a slip start and after each
+                                minimum: it never starts at or hovers around zero (a slip
+                                that starts with zero acceleration, steady sliding). */
 
     /* Compact layout, rebuilt at every restart. */
     size_t *slot;            /* per block: index of xi in y, or SIZE_MAX when stuck */
@@ -70,6 +76,12 @@ void bk_scene_restart(bk_scene *scene, double t, double *y);
 /* Per-component absolute tolerances for the current layout. */
 void bk_scene_tolerances(const bk_scene *scene, double atol_x, double atol_v, double atol_state,
                          double atol_energy, double *atol);
+/* Arm the slip-rate minimum roots of blocks now clearly decelerating (call at step ends;
+ * a disarmed root reads as +1 and its direction is rising-only, so arming cannot fake a
+ * crossing). */
+void bk_scene_arm(bk_scene *scene, double t, const double *y);
+/* Slip acceleration s a of slipping block i for the integrated vector y (m/s^2). */
+double bk_scene_slip_acceleration(const bk_scene *scene, size_t i, double t, const double *y);
 /* Fill x, v, state, work, dissipation from the integrated vector y at time t. */
 void bk_scene_unpack(bk_scene *scene, double t, const double *y);
 

@@ -123,6 +123,56 @@ static void test_paper_configs(void **state)
     check_paper_case("case_c_coulomb_tension_only", 0.5999, 1);
 }
 
+/* The paper's rate-and-state cases as the equations give them (converged, see README):
+ * A and B stick-slip, B's slips more frequent and lower; C slips once, then slides steadily. */
+typedef struct slip_summary {
+    long slips;          /* stick -> slip transitions */
+    double peak;         /* peak slip rate, m/s */
+    double late_swing;   /* max |v - V| over the last second */
+} slip_summary;
+
+static slip_summary summarise(const char *stem)
+{
+    char out[512], cmd[1024];
+    snprintf(out, sizeof out, "%s/%s.h5", tmpdir, stem);
+    snprintf(cmd, sizeof cmd, "./bksim run configs/paper/%s.ini -o %s --quiet", stem, out);
+    assert_int_equal(run(cmd, NULL), 0);
+    bk_transition *tr = NULL;
+    size_t n = 0;
+    bk_error err = {0};
+    assert_int_equal(bk_h5_read_transitions(out, &tr, &n, &err), BK_OK);
+    slip_summary s = {0, 0.0, 0.0};
+    for (size_t k = 0; k < n; ++k)
+        s.slips += tr[k].from == BK_MODE_STICK && tr[k].to != BK_MODE_STICK;
+    double *t = NULL, *v = NULL;
+    size_t rows, cols;
+    assert_int_equal(bk_h5_read_doubles(out, "/time", &t, &rows, &cols, &err), BK_OK);
+    assert_int_equal(bk_h5_read_doubles(out, "/v", &v, &rows, &cols, &err), BK_OK);
+    for (size_t k = 0; k < rows; ++k) {
+        s.peak = fmax(s.peak, fabs(v[k]));
+        if (t[k] >= 4.0)
+            s.late_swing = fmax(s.late_swing, fabs(v[k] - 1e-3));
+    }
+    print_message("%s: %ld slips, peak slip rate %.4g m/s, max |v - V| in the last second %.3g m/s\n",
+                  stem, s.slips, s.peak, s.late_swing);
+    free(t);
+    free(v);
+    free(tr);
+    return s;
+}
+
+static void test_paper_rate_state(void **state)
+{
+    (void)state;
+    slip_summary a = summarise("case_a_rs"), b = summarise("case_b_rs"), c = summarise("case_c_rs");
+    assert_true(a.slips >= 5 && b.slips > a.slips); /* B: more frequent */
+    assert_true(b.peak < 0.5 * a.peak);              /* and lower */
+    assert_int_equal(c.slips, 1);                    /* C: one slip, then steady sliding */
+    assert_true(c.late_swing < 1e-6);
+    slip_summary a_to = summarise("case_a_rs_tension_only");
+    assert_true(a_to.slips >= 2 && a_to.slips < a.slips); /* sparser without the push-back */
+}
+
 /* --- bad input: clear message, exit 2, no file ----------------------------------------- */
 
 static const char *const good_config =
@@ -342,6 +392,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_paper_configs),
+        cmocka_unit_test(test_paper_rate_state),
         cmocka_unit_test(test_bad_inputs),
         cmocka_unit_test(test_commands),
         cmocka_unit_test(test_interrupted_run_is_marked),

@@ -490,6 +490,47 @@ static void test_rows(void **state)
     recorder_free(&r);
 }
 
+/* Any block can use any law; only blocks whose law has state carry state variables, and
+ * the mixed chain keeps its energy balance. */
+static void test_per_block_laws(void **state)
+{
+    (void)state;
+    const char *text =
+        "[model]\nn_blocks = 4\ncoupling_stiffness = 2e4\n"
+        "[block]\nmass = 1\ndriver_stiffness = 1e4\n"
+        "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
+        "[friction.1]\nlaw = rate_state\nmu_s = 0.6\nmu_d = 0.45\n"
+        "[friction.2]\nlaw = carlson_langer\nF0 = 5.5\nsigma = 0.15\nalpha = 2\n"
+        "[friction.3]\nlaw = dieterich_ruina_aging\na = 0.05\nb = 0.06\nDc = 1e-5\nV0 = 1e-3\nf0 = 0.45\n"
+        "[driver]\nvelocity = 1e-3\n[solver]\nmethod = cvode_bdf\nrtol = 1e-9\n[run]\nt_end = 2\n";
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(text, "mixed.ini", NULL, 0, &c, &err), BK_OK);
+    const bk_model *m = c->model;
+    assert_ptr_equal(m->blocks[0].law, &bk_friction_coulomb);
+    assert_ptr_equal(m->blocks[1].law, &bk_friction_rate_state);
+    assert_ptr_equal(m->blocks[2].law, &bk_friction_carlson_langer);
+    assert_ptr_equal(m->blocks[3].law, &bk_friction_dieterich_ruina_aging);
+    assert_int_equal(m->n_friction_state, 2); /* rate_state and dieterich_ruina: one each */
+    assert_int_equal(m->blocks[1].state_offset, 0);
+    assert_int_equal(m->blocks[3].state_offset, 1);
+    recorder r = {0};
+    bk_sink sink = {&r, record_sample, record_transition};
+    bk_run_stats stats;
+    int rc = bk_run(c, &sink, &stats, NULL, NULL, &err);
+    if (rc != BK_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(rc, BK_OK);
+    print_message("mixed chain: %zu transitions, energy residual %.2g\n", r.n_transitions,
+                  stats.energy_residual);
+    assert_true(r.n_transitions > 4);
+    assert_true(fabs(stats.energy_residual) < 1e-6);
+    for (size_t k = 0; k < r.n_transitions; ++k)
+        assert_int_not_equal(r.transitions[k].block, 3); /* it creeps, it never sticks */
+    recorder_free(&r);
+    bk_config_free(c);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -510,6 +551,7 @@ int main(void)
         cmocka_unit_test(test_chattering_guard),
         cmocka_unit_test(test_interrupt),
         cmocka_unit_test(test_rows),
+        cmocka_unit_test(test_per_block_laws),
     };
     return cmocka_run_group_tests_name("run", tests, NULL, NULL);
 }

@@ -106,7 +106,8 @@ static void test_roots_clear_of_zero_after_switch(void **state)
         bk_scene_roots(t, y, g, &s);
         double accel = (0.6 - 0.5) * 9.81;               /* (F_s - f_k) / m */
         assert_close(g[R * 1 + BK_ROOT_MAIN], accel, 1e-9, 0); /* stop: s v / (t - t_switch) -> s a */
-        assert_close(g[R * 1 + BK_ROOT_EXTREMUM], accel, 1e-9, 0);
+        /* The minimum root waits for a deceleration: it reads +1 until then. */
+        assert_close(g[R * 1 + BK_ROOT_EXTREMUM], 1.0, 0, 0);
         /* A moment later the stop function is s v / dt, still about s a. */
         double ydot[16];
         bk_scene_rhs(t, y, ydot, &s);
@@ -122,6 +123,30 @@ static void test_roots_clear_of_zero_after_switch(void **state)
         bk_scene_free(&s);
         bk_model_free(m);
     }
+}
+
+/* The minimum root arms once the block is seen decelerating, and then reads s a. */
+static void test_minimum_root_arming(void **state)
+{
+    (void)state;
+    bk_model *m = make_chain(1, BK_SPRING_LINEAR);
+    bk_scene s;
+    assert_int_equal(bk_scene_init(&s, m, 1), 0);
+    s.mode[0] = BK_MODE_SLIP_POS;
+    s.v[0] = 0.02;
+    s.x[0] = 0.0; /* driver at 0: the spring is relaxed, friction decelerates the block */
+    double y[8], g[4];
+    bk_scene_restart(&s, 0.0, y);
+    assert_int_equal(s.extremum_armed[0], 1); /* decelerating already */
+    bk_scene_roots(0.0, y, g, &s);
+    assert_close(g[BK_ROOT_EXTREMUM], -0.5 * 9.81, 1e-12, 0);
+    s.extremum_armed[0] = 0; /* as after a minimum */
+    bk_scene_roots(0.0, y, g, &s);
+    assert_close(g[BK_ROOT_EXTREMUM], 1.0, 0, 0);
+    bk_scene_arm(&s, 0.0, y);
+    assert_int_equal(s.extremum_armed[0], 1);
+    bk_scene_free(&s);
+    bk_model_free(m);
 }
 
 /* A slack tension-only spring stays slack in the right-hand side until the restart at the
@@ -151,6 +176,7 @@ int main(void)
         cmocka_unit_test(test_layout),
         cmocka_unit_test(test_rhs),
         cmocka_unit_test(test_roots_clear_of_zero_after_switch),
+        cmocka_unit_test(test_minimum_root_arming),
         cmocka_unit_test(test_tension_only_frozen),
     };
     return cmocka_run_group_tests_name("scene", tests, NULL, NULL);

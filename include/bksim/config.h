@@ -45,8 +45,17 @@ typedef struct bk_output_options {
     int event_rows;    /* add a row at every transition instant; default 1 */
 } bk_output_options;
 
+/* A prescribed-motion scene (no dynamics): one block slides at a piecewise-constant slip
+ * rate, its friction state following the law's exact evolution.  Paper Figure 2. */
+typedef struct bk_prescribed {
+    size_t n_segments;
+    double *slip_rate;        /* m/s per segment, >= 0 (0: a hold) */
+    double *duration;         /* s per segment, > 0 */
+} bk_prescribed;
+
 typedef struct bk_config {
     bk_model *model;          /* owned */
+    bk_prescribed *prescribed; /* owned; NULL for the chain's dynamics */
     bk_solver_options solver;
     bk_output_options output;
     double t_end;             /* s, > 0 */

@@ -4,7 +4,11 @@
  * Conventions: forces in N, slip rates in m/s.  sliding_force() returns the magnitude of
  * the friction force while a block slips with slip_rate = s*v in its slip direction s; the
  * integrator may probe slip_rate slightly below zero while it brackets a stop, so a law
- * must return a finite value there.  The force on the block is -s * sliding_force(). */
+ * must return a finite value there.  The force on the block is -s * sliding_force().
+ *
+ * A law without BK_FRICTION_STATIC_THRESHOLD never sticks: its sliding_force must be an
+ * odd, smooth function of the signed slip rate (e.g. regularised rate-and-state), and the
+ * block is integrated through v = 0 without events. */
 #ifndef BKSIM_FRICTION_H
 #define BKSIM_FRICTION_H
 
@@ -48,6 +52,9 @@ typedef struct bk_friction_law {
     void (*state_rate)(const double *params, double speed, const double *state, double *rate);
     /* Initial state; NULL when n_state == 0. */
     void (*state_init)(const double *params, double *state);
+    /* Exact state after dt (s) at constant |slip rate| speed (m/s, 0 for a hold), in place;
+     * NULL when n_state == 0.  Prescribed-motion scenes rely on it. */
+    void (*state_advance)(const double *params, double speed, double dt, double *state);
 } bk_friction_law;
 
 /* Registry: the law named `name`, or NULL. */
@@ -59,5 +66,9 @@ const bk_friction_law *const *bk_friction_laws(void);
 int bk_friction_param_index(const bk_friction_law *law, const char *key);
 
 extern const bk_friction_law bk_friction_coulomb;
+extern const bk_friction_law bk_friction_rate_state;
+extern const bk_friction_law bk_friction_carlson_langer;
+extern const bk_friction_law bk_friction_dieterich_ruina_aging;
+extern const bk_friction_law bk_friction_dieterich_ruina_slip;
 
 #endif

@@ -53,4 +53,5 @@ const bk_friction_law bk_friction_coulomb = {
     .static_threshold = coulomb_static_threshold,
     .state_rate = NULL,
     .state_init = NULL,
+    .state_advance = NULL,
 };

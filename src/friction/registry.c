@@ -5,6 +5,10 @@
 
 static const bk_friction_law *const registered_laws[] = {
     &bk_friction_coulomb,
+    &bk_friction_rate_state,
+    &bk_friction_carlson_langer,
+    &bk_friction_dieterich_ruina_aging,
+    &bk_friction_dieterich_ruina_slip,
     NULL,
 };
 
