@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Apparent coefficient of friction (friction / normal force) of block 0 against time, one
 # panel per run, stacked in the order given.
+# Optional XRANGE=lo:hi (s) zooms in time; the value axes then fit the visible data.
 # usage: plot_cof.sh OUT.png "TITLE" RUN.h5:LABEL:COLOR [RUN.h5:LABEL:COLOR]...
 set -euo pipefail
 bksim=${BKSIM:-./bksim}
@@ -24,6 +25,7 @@ set terminal pngcairo size 1200,800 font 'Sans,13' noenhanced
 set output '$out'
 set multiplot layout $#,1 title '$title'
 set grid
+${XRANGE:+set xrange [$XRANGE]}
 set key top right
 set ylabel 'apparent COF [1]'
 $panels

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Position (top) and velocity (bottom) of block 0 and the driver against time.
+# Optional XRANGE=lo:hi (s) zooms in time; the value axes then fit the visible data.
 # usage: plot_kinematics.sh OUT.png "TITLE" RUN.h5:LABEL:COLOR [RUN.h5:LABEL:COLOR]...
 # The driver (grey) is taken from the first run.  Data come through `bksim export`.
 set -euo pipefail
@@ -29,6 +30,7 @@ set terminal pngcairo size 1200,800 font 'Sans,13' noenhanced
 set output '$out'
 set multiplot layout 2,1 title '$title'
 set grid
+${XRANGE:+set xrange [$XRANGE]}
 set key top left
 set ylabel 'position [mm]'
 set format x ''

@@ -27,6 +27,13 @@ for c in a b c; do
         "$out/case_${c}_coulomb.h5:Coulomb:black" "$out/case_${c}_rs.h5:rate-and-state:red"
     fig=$((fig + 2))
 done
+# Case C's Coulomb cycles (0.2 ms sticks, COF between 0.5999 and 0.6) need a closer look.
+XRANGE=0.6:0.8 scripts/plot_kinematics.sh "$out/fig8_case_c_kinematics_zoom.png" \
+    "Figure 8, zoomed: case C after the first slip" \
+    "$out/case_c_coulomb.h5:Coulomb:black" "$out/case_c_rs.h5:rate-and-state:red"
+XRANGE=0.6:0.8 scripts/plot_cof.sh "$out/fig9_case_c_cof_zoom.png" \
+    "Figure 9, zoomed: case C apparent COF after the first slip" \
+    "$out/case_c_coulomb.h5:Coulomb:black" "$out/case_c_rs.h5:rate-and-state:red"
 # What the tension-only spring (the paper's text) changes in case A.
 scripts/plot_kinematics.sh "$out/case_a_tension_only_kinematics.png" \
     "Case A with a tension-only driver spring (the twins of Figure 4)" \
