@@ -26,7 +26,7 @@ TEST_SUPPORT := $(filter-out $(TEST_SRC),$(wildcard tests/*.c))
 objs = $(patsubst %.c,$(1)/%.o,$(2))
 
 .SECONDARY:
-.PHONY: all test test-plain test-asan clean paper bench install
+.PHONY: all test test-plain test-asan clean paper bench install fuzz
 all: bksim
 
 build/libbksim.a: $(call objs,build,$(LIB_SRC))
@@ -65,8 +65,23 @@ test-asan: bksim $(TESTS_ASAN)
 paper: bksim
 	scripts/run_paper.sh
 
+# Fuzz the config loader with libFuzzer (clang): make fuzz FUZZ_SECONDS=600.  The working
+# corpus lives in build-fuzz/; crashers go to build-fuzz/artifacts/ (keep them as
+# regressions in tests/fuzz/regressions/).
+FUZZ_SECONDS ?= 60
+FUZZ_SRC := $(filter-out src/output/hdf5.c,$(LIB_SRC))
+build-fuzz/fuzz_config: tests/fuzz/fuzz_config.c $(FUZZ_SRC) $(wildcard include/bksim/*.h src/*.h)
+	@mkdir -p build-fuzz
+	clang -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all $(CPPFLAGS) \
+	    -o $@ tests/fuzz/fuzz_config.c $(FUZZ_SRC) $(LDLIBS)
+fuzz: build-fuzz/fuzz_config
+	@mkdir -p build-fuzz/corpus build-fuzz/artifacts
+	cp configs/*/*.ini tests/fuzz/regressions/* build-fuzz/corpus/ 2>/dev/null || true
+	build-fuzz/fuzz_config -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=20 \
+	    -artifact_prefix=build-fuzz/artifacts/ -dict=tests/fuzz/config.dict build-fuzz/corpus
+
 clean:
-	rm -rf build build-asan bksim
+	rm -rf build build-asan build-fuzz bksim
 
 PREFIX ?= /usr/local
 install: bksim build/libbksim.a

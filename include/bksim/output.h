@@ -35,8 +35,17 @@ int bk_h5_writer_finish(bk_h5_writer *writer, const bk_run_stats *stats, bk_erro
  * close, and leave it as "<path>.part".  Frees the writer.  stats may be NULL. */
 void bk_h5_writer_abandon(bk_h5_writer *writer, const char *reason, const bk_run_stats *stats);
 
-/* Summary of an output file: parameters, stick/slip phase counts, solver stats. */
+/* Summary of an output file: parameters, stick/slip phase counts, solver stats, and the
+ * integrity check below.  Returns BK_OK for a complete, intact file, BK_INCOMPLETE for an
+ * intact file of a run that did not finish, BK_ERR_DAMAGED (message says what) or another
+ * negative code for a file that cannot be read. */
 int bk_h5_info(const char *path, FILE *out, bk_error *err);
+
+/* Integrity: root attributes present, /time /driver /event present, every time series as
+ * long as /time with one column per block where per-block, /time finite and strictly
+ * increasing, t_reached its last value, and for a complete run /time ending at t_end.
+ * Same returns as bk_h5_info. */
+int bk_h5_verify(const char *path, bk_error *err);
 
 /* Whitespace-separated columns on out, one row per time sample, after a '#' header naming
  * columns and units.  datasets: comma-separated names (NULL = "time,driver,x,v,friction,

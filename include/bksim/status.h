@@ -10,6 +10,7 @@
 
 /* X(name, value, description): one list makes both the enum and bk_strerror(). */
 #define BK_STATUS_LIST(X)                                                              \
+    X(BK_INCOMPLETE, 1, "output of a run that did not finish")                         \
     X(BK_OK, 0, "success")                                                             \
     X(BK_ERR_INVALID, -1, "invalid argument")                                          \
     X(BK_ERR_CONFIG, -2, "invalid configuration")                                      \
@@ -22,7 +23,8 @@
     X(BK_ERR_NUMERIC, -9, "non-finite value in the solution")                          \
     X(BK_ERR_SINK, -10, "output sink failed")                                          \
     X(BK_ERR_INTERRUPTED, -11, "run interrupted")                                     \
-    X(BK_ERR_INTERNAL, -12, "internal error")
+    X(BK_ERR_INTERNAL, -12, "internal error")                                          \
+    X(BK_ERR_DAMAGED, -13, "damaged output file")
 
 typedef enum bk_status {
 #define BK_STATUS_ENUM(name, value, text) name = value,

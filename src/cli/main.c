@@ -1,6 +1,7 @@
 /* bksim command line: a thin client of the library.  The only place that calls exit.
  *
- * Exit status: 0 success, 1 the run or the file failed, 2 bad usage or bad config. */
+ * Exit status: 0 success, 1 the run or the file failed (or is damaged), 2 bad usage or bad
+ * config, 3 (info) an intact file of a run that did not finish. */
 #include <errno.h>
 #include <limits.h>
 #include <signal.h>
@@ -13,7 +14,7 @@
 
 #include "bksim/bksim.h"
 
-enum { EXIT_RUN_FAILED = 1, EXIT_USAGE = 2 };
+enum { EXIT_RUN_FAILED = 1, EXIT_USAGE = 2, EXIT_INCOMPLETE = 3 };
 
 static const char *const usage_text =
     "usage: bksim <command> [options]\n"
@@ -51,7 +52,10 @@ static const char *const check_help =
 static const char *const info_help =
     "usage: bksim info OUT.h5\n"
     "\n"
-    "Prints the parameters, stick/slip phase counts per block, and solver statistics.\n";
+    "Prints the parameters, stick/slip phase counts per block and solver statistics, and\n"
+    "checks the file: datasets present and equally long, time strictly increasing, the\n"
+    "complete flag.  Exit status 0: intact and complete; 3: intact but the run did not\n"
+    "finish (e.g. OUT.h5.part of an interrupted run); 1: damaged or unreadable.\n";
 
 static const char *const export_help =
     "usage: bksim export OUT.h5 [--datasets a,b,...] [--block I] [--transitions]\n"
@@ -281,7 +285,10 @@ static int cmd_info(int argc, char **argv)
     if (argc != 1)
         return usage_error("info", "%s", argc == 0 ? "missing OUT.h5" : "expects exactly one file");
     bk_error err = {0};
-    if (bk_h5_info(argv[0], stdout, &err) != BK_OK) {
+    int rc = bk_h5_info(argv[0], stdout, &err);
+    if (rc == BK_INCOMPLETE)
+        return EXIT_INCOMPLETE;
+    if (rc != BK_OK) {
         fprintf(stderr, "%s\n", err.message);
         return EXIT_RUN_FAILED;
     }

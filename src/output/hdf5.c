@@ -974,8 +974,12 @@ static int open_input(const char *path, hid_t *file, bk_error *err)
     if (is_hdf5 < 0)
         return H5_FAIL(err, "%s: cannot read", path);
     *file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    size_t len = strlen(path);
+    int partial = len > 5 && strcmp(path + len - 5, ".part") == 0;
     if (*file < 0)
-        return H5_FAIL(err, "%s: cannot open (truncated or corrupt HDF5 file?)", path);
+        return H5_FAIL(err, "%s: cannot open (truncated or corrupt HDF5 file?%s)", path,
+                       partial ? " a .part file is the output of a run that did not finish, "
+                                 "here killed before it could close it" : "");
     return BK_OK;
 }
 
@@ -1393,6 +1397,88 @@ static int count_phases(hid_t file, const char *path, size_t n_blocks, long *sti
     return rc;
 }
 
+/* The integrity check on an open file (see bk_h5_verify). */
+static int verify_open(hid_t file, const char *path, bk_error *err)
+{
+    int complete = 0;
+    long long n_blocks = 0;
+    double t_end = NAN, t_reached = NAN;
+    if (read_numeric_attr(file, "complete", H5T_NATIVE_INT, &complete) < 0 ||
+        read_numeric_attr(file, "n_blocks", H5T_NATIVE_LLONG, &n_blocks) < 0 ||
+        read_numeric_attr(file, "t_end", H5T_NATIVE_DOUBLE, &t_end) < 0 ||
+        read_numeric_attr(file, "t_reached", H5T_NATIVE_DOUBLE, &t_reached) < 0)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: a root attribute (complete, n_blocks, t_end, "
+                       "t_reached) is missing", path);
+    static const char *const required[] = {"time", "driver", "event"};
+    for (size_t k = 0; k < 3; ++k)
+        if (H5Lexists(file, required[k], H5P_DEFAULT) <= 0)
+            return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: no /%s", path, required[k]);
+    hid_t time;
+    hsize_t rows, cols;
+    int rank;
+    int rc = open_series(file, path, "time", &time, &rows, &cols, &rank, err);
+    if (rc != BK_OK)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: %s", path, err ? err->message : "/time");
+    double *t = malloc((rows ? rows : 1) * sizeof *t);
+    if (!t) {
+        close_id(time);
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    }
+    herr_t read = rows ? read_block(time, 1, 0, rows, 0, 1, H5T_NATIVE_DOUBLE, t) : 0;
+    close_id(time);
+    rc = BK_OK;
+    if (read < 0)
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /time cannot be read", path);
+    for (hsize_t i = 0; rc == BK_OK && i < rows; ++i)
+        if (!isfinite(t[i]) || (i > 0 && !(t[i] > t[i - 1])))
+            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /time is not strictly increasing at row %llu "
+                         "(%.17g after %.17g)", path, (unsigned long long)i, t[i], i ? t[i - 1] : NAN);
+    if (rc == BK_OK && rows > 0 && t[rows - 1] != t_reached)
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: t_reached (%.17g) is not the last time (%.17g)",
+                     path, t_reached, t[rows - 1]);
+    if (rc == BK_OK && complete && (rows == 0 || fabs(t[rows - 1] - t_end) > 1e-9 * fabs(t_end)))
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: marked complete but /time ends at %.17g, not "
+                     "t_end = %.17g", path, rows ? t[rows - 1] : NAN, t_end);
+    free(t);
+    if (rc != BK_OK)
+        return rc;
+    name_list list;
+    if (list_series(file, &list) != 0)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: cannot list the datasets", path);
+    for (size_t k = 0; rc == BK_OK && k < list.count; ++k) {
+        hid_t d;
+        hsize_t r, c;
+        int rk;
+        if (open_series(file, path, list.names[k], &d, &r, &c, &rk, err) != BK_OK) {
+            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s cannot be read", path, list.names[k]);
+            continue;
+        }
+        close_id(d);
+        int per_block = rk == 2 && strcmp(list.names[k], "friction_state") != 0;
+        if (r != rows)
+            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s has %llu rows, /time has %llu", path,
+                         list.names[k], (unsigned long long)r, (unsigned long long)rows);
+        else if (per_block && (long long)c != n_blocks)
+            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s has %llu columns for %lld blocks", path,
+                         list.names[k], (unsigned long long)c, n_blocks);
+    }
+    name_list_free(&list);
+    if (rc != BK_OK)
+        return rc;
+    return complete ? BK_OK : BK_INCOMPLETE;
+}
+
+int bk_h5_verify(const char *path, bk_error *err)
+{
+    hid_t file;
+    int rc = open_input(path, &file, err);
+    if (rc != BK_OK)
+        return rc;
+    rc = verify_open(file, path, err);
+    close_id(file);
+    return rc;
+}
+
 int bk_h5_info(const char *path, FILE *out, bk_error *err)
 {
     hid_t file;
@@ -1463,6 +1549,14 @@ int bk_h5_info(const char *path, FILE *out, bk_error *err)
     else
         fprintf(out, "transitions  not recorded\n");
     print_stats(file, out);
+    bk_error check = {0};
+    int integrity = verify_open(file, path, &check);
+    if (integrity == BK_OK)
+        fprintf(out, "integrity    ok\n");
+    else if (integrity == BK_INCOMPLETE)
+        fprintf(out, "integrity    intact, but the run did not finish (complete = 0)\n");
+    else
+        fprintf(out, "integrity    DAMAGED: %s\n", check.message);
 
     free(name);
     free(version);
@@ -1473,7 +1567,9 @@ int bk_h5_info(const char *path, FILE *out, bk_error *err)
     close_id(file);
     if (ferror(out))
         return BK_FAIL(err, BK_ERR_IO, "%s: writing the summary failed", path);
-    return BK_OK;
+    if (integrity < 0 && err)
+        *err = check;
+    return integrity;
 }
 
 /* ----------------------------------------------------------------------- export --- */
