@@ -31,7 +31,7 @@
 
 /* --- the key table ---------------------------------------------------------------------- */
 
-typedef enum key_type { KEY_DOUBLE, KEY_INT, KEY_BOOL, KEY_ENUM, KEY_STRING, KEY_FIELDS, KEY_LIST } key_type;
+
 
 static const char *const boundary_names[] = {"free", "fixed", "periodic", NULL};
 static const char *const spring_names[] = {"linear", "tension_only", NULL};
@@ -59,19 +59,19 @@ static const char *law_name(size_t i)
 typedef struct key_def {
     const char *section;
     bk_param param;               /* key, unit, default, range, flags, doc */
-    key_type type;
-    const char *const *choices;   /* KEY_ENUM with fixed words */
-    const char *(*choice)(size_t); /* KEY_ENUM with registered names */
+    bk_key_kind type;
+    const char *const *choices;   /* BK_KEY_CHOICE with fixed words */
+    const char *(*choice)(size_t); /* BK_KEY_CHOICE with registered names */
     const char *default_text;     /* for the reference when the default is not a number */
 } key_def;
 
-#define NUM(sec, k, unit, def, lo, hi, fl, doc) {sec, {k, unit, def, lo, hi, fl, doc}, KEY_DOUBLE, NULL, NULL, NULL}
-#define INT(sec, k, def, lo, hi, fl, doc) {sec, {k, "1", def, lo, hi, fl, doc}, KEY_INT, NULL, NULL, NULL}
+#define NUM(sec, k, unit, def, lo, hi, fl, doc) {sec, {k, unit, def, lo, hi, fl, doc}, BK_KEY_NUMBER, NULL, NULL, NULL}
+#define INT(sec, k, def, lo, hi, fl, doc) {sec, {k, "1", def, lo, hi, fl, doc}, BK_KEY_INTEGER, NULL, NULL, NULL}
 
 static const key_def keys[] = {
     INT("model", "n_blocks", NAN, 1, MAX_BLOCKS, BK_PARAM_REQUIRED, "number of blocks in the chain"),
     {"model", {"boundary", "", 0, 0, 0, 0, "chain ends: free, fixed (tied to walls at 0) or periodic (a ring)"},
-     KEY_ENUM, boundary_names, NULL, "free"},
+     BK_KEY_CHOICE, boundary_names, NULL, "free"},
     NUM("model", "coupling_stiffness", "N/m", 0.0, 0.0, INFINITY, 0, "stiffness of the springs between neighbours"),
     NUM("model", "gravity", "m/s^2", 9.81, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
         "gravitational acceleration, for the default normal force"),
@@ -80,67 +80,82 @@ static const key_def keys[] = {
     NUM("block", "driver_stiffness", "N/m", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED,
         "stiffness of the spring from the driver to the block"),
     {"block", {"normal_force", "N", NAN, 0.0, INFINITY, BK_PARAM_DERIVED | BK_PARAM_MIN_EXCLUSIVE,
-               "normal force on the block"}, KEY_DOUBLE, NULL, NULL, "mass * gravity"},
+               "normal force on the block"}, BK_KEY_NUMBER, NULL, NULL, "mass * gravity"},
     NUM("block", "x_init", "m", 0.0, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
         "initial displacement from the relaxed configuration"),
     NUM("block", "v_init", "m/s", 0.0, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
         "initial velocity (non-zero: the block starts slipping that way)"),
 
     {"friction", {"law", "", NAN, 0, 0, BK_PARAM_REQUIRED, "friction law; its parameters follow in the same section"},
-     KEY_ENUM, NULL, law_name, NULL},
+     BK_KEY_CHOICE, NULL, law_name, NULL},
 
     NUM("driver", "velocity", "m/s", NAN, -INFINITY, INFINITY,
         BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE, "driver velocity (constant)"),
     {"driver", {"spring", "", 0, 0, 0, 0, "driver springs: linear, or tension_only (pull, never push; NOTES.md 3)"},
-     KEY_ENUM, spring_names, NULL, "linear"},
+     BK_KEY_CHOICE, spring_names, NULL, "linear"},
     NUM("driver", "start_position", "m", 0.0, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
         "driver position at t = 0 (0: at the relaxed blocks)"),
 
-    {"solver", {"method", "", 0, 0, 0, 0, "integrator back-end"}, KEY_ENUM, NULL, method_name, "cvode_adams"},
+    {"solver", {"method", "", 0, 0, 0, 0, "integrator back-end"}, BK_KEY_CHOICE, NULL, method_name, "cvode_adams"},
     {"solver", {"linear_solver", "", 0, 0, 0, 0, "linear solver of implicit methods: auto (band for long chains), dense, band"},
-     KEY_ENUM, linear_solver_names, NULL, "auto"},
+     BK_KEY_CHOICE, linear_solver_names, NULL, "auto"},
     NUM("solver", "rtol", "1", 1e-8, 1e-15, 0.1, 0, "relative tolerance"),
     {"solver", {"atol_x", "m", NAN, 0.0, INFINITY, BK_PARAM_DERIVED | BK_PARAM_MIN_EXCLUSIVE,
-                "absolute tolerance on positions"}, KEY_DOUBLE, NULL, NULL, "rtol * 1e-3 * max(F_s / k)"},
+                "absolute tolerance on positions"}, BK_KEY_NUMBER, NULL, NULL, "rtol * 1e-3 * max(F_s / k)"},
     {"solver", {"atol_v", "m/s", NAN, 0.0, INFINITY, BK_PARAM_DERIVED | BK_PARAM_MIN_EXCLUSIVE,
-                "absolute tolerance on velocities"}, KEY_DOUBLE, NULL, NULL,
+                "absolute tolerance on velocities"}, BK_KEY_NUMBER, NULL, NULL,
      "rtol * 1e-3 * min(driver speed, max(F_s / k) * omega_max)"},
     {"solver", {"max_step", "s", NAN, 0.0, INFINITY, BK_PARAM_DERIVED | BK_PARAM_MIN_EXCLUSIVE,
                 "largest integrator step (keeps a slip-rate extremum from hiding inside a step)"},
-     KEY_DOUBLE, NULL, NULL, "1/8 of the fastest natural period"},
+     BK_KEY_NUMBER, NULL, NULL, "1/8 of the fastest natural period"},
     INT("solver", "max_steps", 100000, 1, INT_MAX, 0, "integrator steps allowed between two output rows"),
     {"solver", {"detect_velocity_extrema", "", 1, 0, 1, 0,
-                "locate slip-rate minima to catch a stop hidden inside one step"}, KEY_BOOL, NULL, NULL, "true"},
+                "locate slip-rate minima to catch a stop hidden inside one step"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
     INT("solver", "max_transitions_per_instant", 100, 1, INT_MAX, 0,
         "transitions of one block within instant_window before the run stops as chattering"),
     {"solver", {"instant_window", "s", NAN, 0.0, INFINITY, BK_PARAM_DERIVED | BK_PARAM_MIN_EXCLUSIVE,
-                "transitions closer than this count as one instant"}, KEY_DOUBLE, NULL, NULL,
+                "transitions closer than this count as one instant"}, BK_KEY_NUMBER, NULL, NULL,
      "1e-6 of the fastest natural period"},
 
-    {"output", {"path", "", 0, 0, 0, 0, "HDF5 output file (bksim run -o overrides)"}, KEY_STRING, NULL, NULL,
+    NUM("solver", "min_step", "s", 0.0, 0.0, INFINITY, 0,
+        "a step size below this stops the run with an error (0: no limit)"),
+
+    {"output", {"path", "", 0, 0, 0, 0, "HDF5 output file (bksim run -o overrides)"}, BK_KEY_TEXT, NULL, NULL,
      "config file name, .ini replaced by .h5"},
     {"output", {"interval", "s", NAN, 0.0, INFINITY, BK_PARAM_DERIVED,
                 "time between samples, <= t_end; 0: rows only at transitions (and t = 0, t_end)"},
-     KEY_DOUBLE, NULL, NULL, "t_end / 1000"},
+     BK_KEY_NUMBER, NULL, NULL, "t_end / 1000"},
     {"output", {"fields", "", 0, 0, 0, 0, "per-row datasets: all, or a list of x v friction cof mode energy state"},
-     KEY_FIELDS, field_names, NULL, "all"},
-    {"output", {"transitions", "", 1, 0, 1, 0, "write the /transitions table"}, KEY_BOOL, NULL, NULL, "true"},
-    {"output", {"event_rows", "", 1, 0, 1, 0, "add a row at every transition instant"}, KEY_BOOL, NULL, NULL, "true"},
+     BK_KEY_FIELDS, field_names, NULL, "all"},
+    {"output", {"transitions", "", 1, 0, 1, 0, "write the /transitions table"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
+    {"output", {"event_rows", "", 1, 0, 1, 0, "add a row at every transition instant"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
 
     NUM("run", "t_end", "s", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE,
         "end time (runs from 0); in a prescribed scene optional, at most the schedule's length"),
+    NUM("run", "wall_time_limit", "s", 0.0, 0.0, INFINITY, 0,
+        "wall-clock time after which the run stops with an error, keeping what it wrote (0: no limit)"),
 
     {"prescribed", {"slip_rates", "m/s", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED,
-                    "slip rate of each segment, in order (0: a hold)"}, KEY_LIST, NULL, NULL, NULL},
+                    "slip rate of each segment, in order (0: a hold)"}, BK_KEY_LIST, NULL, NULL, NULL},
     {"prescribed", {"durations", "s", NAN, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
-                    "duration of each segment (give durations or distances)"}, KEY_LIST, NULL, NULL, "-"},
+                    "duration of each segment (give durations or distances)"}, BK_KEY_LIST, NULL, NULL, "-"},
     {"prescribed", {"distances", "m", NAN, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
-                    "slip distance of each segment (not for holds)"}, KEY_LIST, NULL, NULL, "-"},
+                    "slip distance of each segment (not for holds)"}, BK_KEY_LIST, NULL, NULL, "-"},
 };
 #define N_KEYS (sizeof keys / sizeof keys[0])
 
 static const char *const sections[] = {"model", "block", "friction", "driver", "solver", "output", "run",
                                        "prescribed", NULL};
+
+int bk_config_key(size_t i, bk_key_info *info)
+{
+    if (i >= N_KEYS)
+        return -1;
+    info->section = keys[i].section;
+    info->param = &keys[i].param;
+    info->kind = keys[i].type;
+    return 0;
+}
 
 static const key_def *find_key(const char *section, const char *key)
 {
@@ -169,7 +184,7 @@ typedef struct entry {
     long rank;                 /* position for "first error" */
     int superseded;            /* replaced by a later override */
     double number;             /* parsed value (numbers, bools, enum index, list length) */
-    double *list;              /* KEY_LIST values, owned */
+    double *list;              /* BK_KEY_LIST values, owned */
 } entry;
 
 typedef struct loader {
@@ -335,31 +350,31 @@ static int on_pair(void *user, const char *section, const char *key, const char 
 
 static void format_allowed(const key_def *def, const bk_param *param, char *buf, size_t len)
 {
-    if (def && def->type == KEY_LIST) {
+    if (def && def->type == BK_KEY_LIST) {
         char range[256];
         bk_param_format_range(param, range, sizeof range);
         snprintf(buf, len, "numbers separated by commas or spaces, each %s", range);
         return;
     }
-    if (!def || def->type == KEY_DOUBLE || def->type == KEY_INT) {
+    if (!def || def->type == BK_KEY_NUMBER || def->type == BK_KEY_INTEGER) {
         bk_param_format_range(param, buf, len);
-        if (def && def->type == KEY_INT) {
+        if (def && def->type == BK_KEY_INTEGER) {
             size_t used = strlen(buf);
             snprintf(buf + used, len - used, ", an integer");
         }
         return;
     }
-    if (def->type == KEY_BOOL) {
+    if (def->type == BK_KEY_BOOLEAN) {
         snprintf(buf, len, "true, false, yes, no, on, off, 1, 0");
         return;
     }
-    if (def->type == KEY_STRING) {
+    if (def->type == BK_KEY_TEXT) {
         snprintf(buf, len, "a non-empty text");
         return;
     }
     size_t used = 0;
     buf[0] = '\0';
-    if (def->type == KEY_FIELDS)
+    if (def->type == BK_KEY_FIELDS)
         used += (size_t)snprintf(buf, len, "all, or a list of ");
     for (size_t i = 0; enum_choice(def, i) && used < len; ++i)
         used += (size_t)snprintf(buf + used, len - used, "%s%s", i ? ", " : "", enum_choice(def, i));
@@ -457,16 +472,16 @@ static int check_value(loader *ld, entry *e, const key_def *def, const bk_param 
 {
     char allowed[512];
     format_allowed(def, param, allowed, sizeof allowed);
-    key_type type = def ? def->type : KEY_DOUBLE;
+    bk_key_kind type = def ? def->type : BK_KEY_NUMBER;
     const char *v = e->value;
     switch (type) {
-    case KEY_DOUBLE:
-    case KEY_INT: {
-        int bad = type == KEY_INT ? parse_integer(v, &e->number) : parse_number(v, &e->number);
+    case BK_KEY_NUMBER:
+    case BK_KEY_INTEGER: {
+        int bad = type == BK_KEY_INTEGER ? parse_integer(v, &e->number) : parse_number(v, &e->number);
         if (bad) {
             const char *hint = strchr(v, '#') ? " (inline comments start with ';')" : "";
             report_entry(ld, e, "%s \"%s\"%s (allowed: %s)",
-                         type == KEY_INT ? "not an integer:" : "not a number:", v, hint, allowed);
+                         type == BK_KEY_INTEGER ? "not an integer:" : "not a number:", v, hint, allowed);
             return -1;
         }
         if (!bk_param_in_range(param, e->number)) {
@@ -475,13 +490,13 @@ static int check_value(loader *ld, entry *e, const key_def *def, const bk_param 
         }
         return 0;
     }
-    case KEY_BOOL:
+    case BK_KEY_BOOLEAN:
         if (parse_bool(v, &e->number)) {
             report_entry(ld, e, "not a boolean: \"%s\" (allowed: %s)", v, allowed);
             return -1;
         }
         return 0;
-    case KEY_ENUM:
+    case BK_KEY_CHOICE:
         for (size_t i = 0; enum_choice(def, i); ++i)
             if (strcmp(enum_choice(def, i), v) == 0) {
                 e->number = (double)i;
@@ -489,13 +504,13 @@ static int check_value(loader *ld, entry *e, const key_def *def, const bk_param 
             }
         report_entry(ld, e, "unknown value \"%s\" (allowed: %s)", v, allowed);
         return -1;
-    case KEY_STRING:
+    case BK_KEY_TEXT:
         if (!*v) {
             report_entry(ld, e, "empty value (allowed: %s)", allowed);
             return -1;
         }
         return 0;
-    case KEY_LIST: {
+    case BK_KEY_LIST: {
         size_t count = 0, cap = 8;
         e->list = malloc(cap * sizeof *e->list);
         const char *p = v;
@@ -534,7 +549,7 @@ static int check_value(loader *ld, entry *e, const key_def *def, const bk_param 
         e->number = (double)count;
         return 0;
     }
-    case KEY_FIELDS: {
+    case BK_KEY_FIELDS: {
         char bad[64];
         if (parse_fields(v, &e->number, bad, sizeof bad)) {
             report_entry(ld, e, "unknown field \"%s\" (allowed: %s)", bad, allowed);
@@ -660,11 +675,11 @@ static double value_of(loader *ld, const char *section, const char *key)
     if (e)
         return e->number;
     const key_def *def = find_key(section, key);
-    if (def->type == KEY_ENUM && def->default_text)
+    if (def->type == BK_KEY_CHOICE && def->default_text)
         for (size_t i = 0; enum_choice(def, i); ++i)
             if (strcmp(enum_choice(def, i), def->default_text) == 0)
                 return (double)i;
-    if (def->type == KEY_FIELDS)
+    if (def->type == BK_KEY_FIELDS)
         return (double)BK_FIELD_ALL;
     if (def->param.flags & BK_PARAM_REQUIRED)
         report_missing(ld, section, &def->param, def);
@@ -896,6 +911,8 @@ static bk_config *build(loader *ld)
     s->detect_velocity_extrema = (int)value_of(ld, "solver", "detect_velocity_extrema");
     s->max_transitions_per_instant = (long)value_of(ld, "solver", "max_transitions_per_instant");
     s->instant_window = value_of(ld, "solver", "instant_window");
+    s->min_step = value_of(ld, "solver", "min_step");
+    c->wall_time_limit = value_of(ld, "run", "wall_time_limit");
 
     bk_output_options *o = &c->output;
     entry *path = lookup(ld, "output", "path");
@@ -1080,7 +1097,7 @@ static void write_default(FILE *out, const key_def *def, const bk_param *param)
         fprintf(out, "%s", def->default_text);
     else if (param->flags & BK_PARAM_REQUIRED)
         fprintf(out, "required");
-    else if (def && def->type == KEY_BOOL)
+    else if (def && def->type == BK_KEY_BOOLEAN)
         fprintf(out, "%s", param->default_value != 0 ? "true" : "false");
     else
         fprintf(out, "%g", param->default_value);

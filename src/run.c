@@ -63,6 +63,7 @@ typedef struct run_ctx {
     long *instant_count;
 
     double elastic0, kinetic0;
+    double wall_start;    /* s, monotonic clock at the start */
 } run_ctx;
 
 /* --- output ---------------------------------------------------------------------------- */
@@ -359,10 +360,16 @@ static int check_finite(run_ctx *ctx, double t)
     return BK_OK;
 }
 
+static double wall_seconds(void);
+
 static int report_progress(run_ctx *ctx, double t)
 {
     if (ctx->progress && ctx->progress(ctx->progress_user, t, ctx->t_end) != 0)
         return BK_FAIL(ctx->err, BK_ERR_INTERRUPTED, "run interrupted at t = %.17g s", t);
+    double limit = ctx->config->wall_time_limit;
+    if (limit > 0.0 && wall_seconds() - ctx->wall_start > limit)
+        return BK_FAIL(ctx->err, BK_ERR_INTERRUPTED,
+                       "[run] wall_time_limit = %g s reached at t = %.17g s of %g s", limit, t, ctx->t_end);
     return BK_OK;
 }
 
@@ -418,7 +425,7 @@ static int integrate(run_ctx *ctx, double *t)
             return BK_OK;
         }
         if ((rc = report_progress(ctx, t_reached)) != BK_OK)
-            return rc;
+            return rc; /* every step, so that a wall-clock limit bites inside long segments */
     }
 }
 
@@ -647,6 +654,7 @@ int bk_run(const bk_config *config, const bk_sink *sink, bk_run_stats *stats,
     ctx.interval = config->output.interval;
     ctx.event_rows = config->output.event_rows;
     ctx.next_sample = 0;
+    ctx.wall_start = wall0;
     if (stats) {
         memset(stats, 0, sizeof *stats);
         snprintf(stats->method, sizeof stats->method, "%s", config->solver.method);

@@ -2,6 +2,7 @@
  * configs give the closed-form transitions in the HDF5 file; every bad input gives a
  * clear message, exit status 2 and no output file. Runs ./bksim from the repository root. */
 #define _POSIX_C_SOURCE 200809L
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -274,6 +275,198 @@ static void test_bad_inputs(void **state)
     free(text);
 }
 
+/* --- every key rejects every kind of bad value the same way ----------------------------- */
+
+typedef struct base_section {
+    const char *name;
+    const char *lines[12];
+} base_section;
+
+/* A valid config for `law` (NULL: coulomb), or a prescribed scene. */
+static size_t base_config(const char *law, int prescribed, base_section *out)
+{
+    static const base_section chain[] = {
+        {"model", {"n_blocks = 1"}},
+        {"block", {"mass = 1", "driver_stiffness = 1e4"}},
+        {"friction", {0}},
+        {"driver", {"velocity = 1e-3"}},
+        {"solver", {0}},
+        {"output", {0}},
+        {"run", {"t_end = 0.01"}},
+    };
+    size_t n = 0;
+    if (prescribed) {
+        out[n++] = (base_section){"prescribed", {"slip_rates = 1e-3", "durations = 0.01"}};
+    } else {
+        for (size_t k = 0; k < sizeof chain / sizeof chain[0]; ++k)
+            out[n++] = chain[k];
+    }
+    base_section friction = {"friction", {"law = coulomb", "mu_s = 0.6", "mu_d = 0.5"}};
+    if (law && strcmp(law, "carlson_langer") == 0)
+        friction = (base_section){"friction", {"law = carlson_langer", "F0 = 5", "sigma = 0.2", "alpha = 3"}};
+    else if (law && strcmp(law, "rate_state") == 0)
+        friction = (base_section){"friction", {"law = rate_state"}};
+    else if (law && strncmp(law, "dieterich_ruina", 15) == 0)
+        friction = (base_section){"friction", {law[16] == 'a' ? "law = dieterich_ruina_aging" : "law = dieterich_ruina_slip",
+                                               "a = 0.05", "b = 0.06", "Dc = 1e-5", "V0 = 1e-3", "f0 = 0.45"}};
+    for (size_t k = 0; k < n; ++k)
+        if (strcmp(out[k].name, "friction") == 0)
+            out[k] = friction;
+    if (prescribed)
+        out[n++] = friction;
+    return n;
+}
+
+/* Write the base with `key = value` in [section] (replacing the base's own line for key);
+ * returns the line number of that line. */
+static int write_with(const char *path, const base_section *base, size_t n, const char *section,
+                      const char *key, const char *value)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    int line = 0, at = 0, placed = 0;
+    size_t key_len = strlen(key);
+    for (size_t k = 0; k < n; ++k) {
+        fprintf(f, "[%s]\n", base[k].name);
+        ++line;
+        for (size_t j = 0; j < 12 && base[k].lines[j]; ++j) {
+            const char *l = base[k].lines[j];
+            if (strcmp(base[k].name, section) == 0 && strncmp(l, key, key_len) == 0 && l[key_len] == ' ')
+                continue;
+            fprintf(f, "%s\n", l);
+            ++line;
+        }
+        if (strcmp(base[k].name, section) == 0) {
+            fprintf(f, "%s = %s\n", key, value);
+            at = ++line;
+            placed = 1;
+        }
+    }
+    if (!placed) {
+        fprintf(f, "[%s]\n%s = %s\n", section, key, value);
+        at = line + 2;
+    }
+    fclose(f);
+    return at;
+}
+
+/* The message a bad value of this kind must get, or NULL when the value is acceptable on
+ * its own (a cross-key rule may still reject it, but not as a malformed value). */
+static const char *expected_complaint(bk_key_kind kind, const bk_param *param, const char *value, char *buf,
+                                      size_t len)
+{
+    char *end = NULL;
+    double x = strtod(value, &end);
+    int numeric = *value && end && *end == '\0' && isfinite(x);
+    switch (kind) {
+    case BK_KEY_NUMBER:
+    case BK_KEY_INTEGER: {
+        char range[256];
+        bk_param_format_range(param, range, sizeof range);
+        int integral = numeric && x == floor(x) && !strchr(value, 'e') && !strchr(value, '.');
+        if (!numeric || (kind == BK_KEY_INTEGER && !integral))
+            snprintf(buf, len, "%s \"%s\"", kind == BK_KEY_INTEGER ? "not an integer:" : "not a number:", value);
+        else if (!bk_param_in_range(param, x))
+            snprintf(buf, len, "out of range, got %s (allowed: %s", value, range);
+        else
+            return NULL;
+        return buf;
+    }
+    case BK_KEY_LIST:
+        if (!*value)
+            snprintf(buf, len, "empty list");
+        else if (!numeric || !bk_param_in_range(param, x))
+            snprintf(buf, len, "bad value \"%s\" (item 1)", value);
+        else
+            return NULL;
+        return buf;
+    case BK_KEY_BOOLEAN:
+        if (strcmp(value, "0") == 0)
+            return NULL;
+        snprintf(buf, len, "not a boolean: \"%s\"", value);
+        return buf;
+    case BK_KEY_CHOICE:
+        snprintf(buf, len, "unknown value \"%s\"", value);
+        return buf;
+    case BK_KEY_TEXT:
+        if (*value)
+            return NULL;
+        snprintf(buf, len, "empty value");
+        return buf;
+    case BK_KEY_FIELDS:
+        snprintf(buf, len, "unknown field \"%s\"", *value ? value : "(empty)");
+        return buf;
+    }
+    return NULL;
+}
+
+static long check_key(const char *law, int prescribed, const char *section, bk_key_kind kind, const bk_param *param)
+{
+    char out_of_range[64];
+    if (isfinite(param->max))
+        snprintf(out_of_range, sizeof out_of_range, "%.17g", param->max * 10 + 1);
+    else if (isfinite(param->min))
+        snprintf(out_of_range, sizeof out_of_range, "%.17g", param->min - 1);
+    else
+        snprintf(out_of_range, sizeof out_of_range, "1e400");
+    const char *values[] = {"", "abc", "nan", "inf", "-inf", "-1", "0", out_of_range};
+    base_section base[10];
+    size_t n = base_config(law, prescribed, base);
+    char path[512], out[512], part[600], cmd[2048];
+    snprintf(path, sizeof path, "%s/key.ini", tmpdir);
+    snprintf(out, sizeof out, "%s/key.h5", tmpdir);
+    snprintf(part, sizeof part, "%s.part", out);
+    long rejected = 0;
+    for (size_t v = 0; v < sizeof values / sizeof values[0]; ++v) {
+        int line = write_with(path, base, n, section, param->key, values[v]);
+        char complaint[512], prefix[600];
+        const char *expected = expected_complaint(kind, param, values[v], complaint, sizeof complaint);
+        snprintf(prefix, sizeof prefix, "%s:%d: [%s] %s: ", path, line, section, param->key);
+        bk_config *c = NULL;
+        bk_error err = {0};
+        int rc = bk_config_load_file(path, NULL, 0, &c, &err);
+        bk_config_free(c);
+        if (!expected) {
+            /* Acceptable as a value: anything rejected must be a cross-key rule. */
+            if (rc != BK_OK && strncmp(err.message, prefix, strlen(prefix)) == 0 &&
+                (strstr(err.message, "not a number") || strstr(err.message, "out of range")))
+                fail_msg("%s = \"%s\" was rejected as malformed: %s", param->key, values[v], err.message);
+            continue;
+        }
+        char full[1200];
+        snprintf(full, sizeof full, "%s%s", prefix, expected);
+        if (rc != BK_ERR_CONFIG || strncmp(err.message, full, strlen(full)) != 0)
+            fail_msg("[%s] %s = \"%s\" (law %s):\n got:      %s\n expected: %s...", section, param->key,
+                     values[v], law ? law : "-", err.message, full);
+        if (!strstr(err.message, "(allowed: "))
+            fail_msg("no allowed range in: %s", err.message);
+        /* The CLI: exit status 2, the same message, and no file. */
+        snprintf(cmd, sizeof cmd, "./bksim run %s -o %s", path, out);
+        char *text = NULL;
+        assert_int_equal(run(cmd, &text), 2);
+        assert_non_null(strstr(text, full));
+        free(text);
+        assert_false(exists(out));
+        assert_false(exists(part));
+        ++rejected;
+    }
+    return rejected;
+}
+
+static void test_every_key_rejects_bad_values(void **state)
+{
+    (void)state;
+    long rejected = 0, keys = 0;
+    bk_key_info info;
+    for (size_t i = 0; bk_config_key(i, &info) == 0; ++i, ++keys)
+        rejected += check_key(NULL, strcmp(info.section, "prescribed") == 0, info.section, info.kind, info.param);
+    for (const bk_friction_law *const *l = bk_friction_laws(); *l; ++l)
+        for (size_t p = 0; p < (*l)->n_params; ++p, ++keys)
+            rejected += check_key((*l)->name, 0, "friction", BK_KEY_NUMBER, &(*l)->params[p]);
+    print_message("%ld keys, %ld bad values rejected with exact messages, exit 2, no file\n", keys, rejected);
+    assert_true(keys > 50 && rejected > 5 * keys);
+}
+
 /* --- the other commands ---------------------------------------------------------------- */
 
 static void test_commands(void **state)
@@ -456,6 +649,38 @@ static void test_damaged_files(void **state)
     assert_non_null(strstr(err.message, "/v has 100 rows"));
 }
 
+/* Every guard against a hang stops the run with a message naming its key, and keeps what
+ * was written as an incomplete .part. */
+static void test_limits(void **state)
+{
+    (void)state;
+    const struct {
+        const char *sets, *message;
+    } cases[] = {
+        {"--set solver.min_step=1e-3", "[solver] min_step = 0.001 s at t = 0.5886"},
+        {"--set run.wall_time_limit=0.05 --set run.t_end=1e6", "[run] wall_time_limit = 0.05 s reached at t = "},
+        {"--set solver.max_steps=5", "more than 5 solver steps since the last output row"},
+        {"--set friction.mu_d=0.5999 --set solver.max_transitions_per_instant=1 --set solver.instant_window=1e-3",
+         "block 0: more than 1 transitions within 0.001 s at t = 0.6514"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        char out[512], part[600], cmd[2048];
+        snprintf(out, sizeof out, "%s/limit%zu.h5", tmpdir, k);
+        snprintf(part, sizeof part, "%s.part", out);
+        snprintf(cmd, sizeof cmd, "./bksim run configs/paper/case_a_coulomb.ini -o %s -q %s", out, cases[k].sets);
+        char *text = NULL;
+        int status = run(cmd, &text);
+        if (status != 1 || !strstr(text, cases[k].message))
+            print_error("case %zu: status %d\n%s\nexpected: %s\n", k, status, text, cases[k].message);
+        assert_int_equal(status, 1);
+        assert_non_null(strstr(text, cases[k].message));
+        free(text);
+        assert_false(exists(out));
+        bk_error err = {0};
+        assert_int_equal(bk_h5_verify(part, &err), BK_INCOMPLETE);
+    }
+}
+
 /* README's config reference is exactly what `bksim keys` prints. */
 static void test_readme_reference_current(void **state)
 {
@@ -488,10 +713,12 @@ int main(void)
         cmocka_unit_test(test_paper_configs),
         cmocka_unit_test(test_paper_rate_state),
         cmocka_unit_test(test_bad_inputs),
+        cmocka_unit_test(test_every_key_rejects_bad_values),
         cmocka_unit_test(test_commands),
         cmocka_unit_test(test_interrupted_run_is_marked),
         cmocka_unit_test(test_killed_run_leaves_partial),
         cmocka_unit_test(test_damaged_files),
+        cmocka_unit_test(test_limits),
         cmocka_unit_test(test_readme_reference_current),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);

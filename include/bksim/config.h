@@ -35,6 +35,7 @@ typedef struct bk_solver_options {
     long max_transitions_per_instant; /* per block, before a chattering error; default 100 */
     double instant_window;  /* s: transitions closer than this count as one instant;
                                NaN = auto (1e-6 of the fastest natural period) */
+    double min_step;        /* s: a step below this is an error; 0 = no limit (default) */
 } bk_solver_options;
 
 typedef struct bk_output_options {
@@ -59,6 +60,8 @@ typedef struct bk_config {
     bk_solver_options solver;
     bk_output_options output;
     double t_end;             /* s, > 0 */
+    double wall_time_limit;   /* s of wall-clock time before the run stops with an error;
+                                 0 = no limit (default) */
     char *source_name;        /* config file path (or the name given to load_string), owned */
     char *text;               /* config text with the --set overrides appended, owned */
 } bk_config;
@@ -77,5 +80,25 @@ void bk_config_free(bk_config *config);
 /* Write the key reference (every section and key: meaning, unit, default, range) as
  * Markdown tables. */
 void bk_config_write_reference(FILE *out);
+
+/* The table of keys, for tools and tests: what a value of each key must look like. */
+typedef enum bk_key_kind {
+    BK_KEY_NUMBER,  /* a finite number in the param's range */
+    BK_KEY_INTEGER, /* an integer in the param's range */
+    BK_KEY_BOOLEAN,
+    BK_KEY_CHOICE,  /* one word of a fixed or registered list */
+    BK_KEY_TEXT,    /* non-empty text */
+    BK_KEY_FIELDS,  /* a list of output field names */
+    BK_KEY_LIST     /* numbers separated by commas or spaces, each in the param's range */
+} bk_key_kind;
+
+typedef struct bk_key_info {
+    const char *section;    /* "model", "block", ...; per-law friction keys are in the laws' tables */
+    const bk_param *param;  /* key, unit, default, range, flags, doc */
+    bk_key_kind kind;
+} bk_key_info;
+
+/* The i-th key; returns 0 and fills *info, or -1 past the end. */
+int bk_config_key(size_t i, bk_key_info *info);
 
 #endif

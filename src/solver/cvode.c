@@ -230,6 +230,8 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     if (isfinite(cv->options.max_step) && cv->options.max_step > 0 &&
         (flag = CVodeSetMaxStep(cv->cvode, cv->options.max_step)) != CV_SUCCESS)
         return fail(cv, err, "CVodeSetMaxStep", flag);
+    if (cv->options.min_step > 0 && (flag = CVodeSetMinStep(cv->cvode, cv->options.min_step)) != CV_SUCCESS)
+        return fail(cv, err, "CVodeSetMinStep", flag);
     cv->t_stop = t_stop;
     return BK_OK;
 }
@@ -249,6 +251,10 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
     case CV_TSTOP_RETURN:
         return BK_STEP_STOP;
     default:
+        if (cv->options.min_step > 0 && strstr(cv->message, "hmin"))
+            return BK_FAIL(err, BK_ERR_SOLVER,
+                           "the step size fell to [solver] min_step = %g s at t = %.17g s (%s)",
+                           cv->options.min_step, t, cv->message);
         return fail(cv, err, "CVode step", flag);
     }
 }
