@@ -26,7 +26,7 @@ TEST_SUPPORT := $(filter-out $(TEST_SRC),$(wildcard tests/*.c))
 objs = $(patsubst %.c,$(1)/%.o,$(2))
 
 .SECONDARY:
-.PHONY: all test test-plain test-asan clean paper bench install fuzz
+.PHONY: all test test-plain test-asan test-valgrind lint clean paper bench install fuzz
 all: bksim
 
 build/libbksim.a: $(call objs,build,$(LIB_SRC))
@@ -61,6 +61,15 @@ test-asan: bksim $(TESTS_ASAN)
 	 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
 	 scripts/run_tests.sh build-asan/tests $(TESTS_ASAN)
+
+# The whole suite under valgrind memcheck (CI runs it once): no leaks, no invalid access.
+test-valgrind: bksim $(TESTS)
+	@VALGRIND="valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible --show-leak-kinds=definite,indirect,possible" \
+	 scripts/run_tests.sh valgrind $(TESTS)
+
+# Static analysis; options and suppressions are committed in tests/cppcheck.cfg.
+lint:
+	cppcheck $$(cat tests/cppcheck.cfg) -Iinclude -Isrc src tests/*.c tests/fuzz/*.c
 
 paper: bksim
 	scripts/run_paper.sh

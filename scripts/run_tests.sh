@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Run every test program given; report each, fail if any failed.
+# Run every test program given (under $VALGRIND when set); report each, fail if any failed.
 set -u
 label=$1; shift
 failed=()
 for t in "$@"; do
-    if "$t"; then :; else failed+=("$t"); fi
+    if ${VALGRIND:-} "$t"; then :; else failed+=("$t"); fi
 done
 if [ ${#failed[@]} -ne 0 ]; then
     echo "FAILED ($label): ${failed[*]}" >&2

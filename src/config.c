@@ -195,7 +195,7 @@ typedef struct loader {
     bk_error *err;
     int status;
     /* reader state */
-    const char *text, *cursor;
+    const char *cursor;
     int line;
     int section_line;          /* line of the last [section] header read */
     int oom;
@@ -513,8 +513,11 @@ static int check_value(loader *ld, entry *e, const key_def *def, const bk_param 
     case BK_KEY_LIST: {
         size_t count = 0, cap = 8;
         e->list = malloc(cap * sizeof *e->list);
-        const char *p = v;
-        while (e->list) {
+        if (!e->list) {
+            ld->oom = 1;
+            return -1;
+        }
+        for (const char *p = v;;) {
             while (*p == ',' || isspace((unsigned char)*p))
                 ++p;
             if (!*p)
@@ -531,16 +534,14 @@ static int check_value(loader *ld, entry *e, const key_def *def, const bk_param 
             }
             if (count == cap) {
                 double *grown = realloc(e->list, 2 * cap * sizeof *grown);
-                if (!grown)
-                    break;
+                if (!grown) {
+                    ld->oom = 1;
+                    return -1;
+                }
                 e->list = grown;
                 cap *= 2;
             }
             e->list[count++] = x;
-        }
-        if (!e->list) {
-            ld->oom = 1;
-            return -1;
         }
         if (count == 0) {
             report_entry(ld, e, "empty list (allowed: %s)", allowed);
@@ -727,7 +728,7 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
         if (e) {
             b->friction_params[p] = e->number;
         } else if (param->flags & BK_PARAM_REQUIRED) {
-            report_missing(ld, e || !own_law ? "friction" : param_section, param, NULL);
+            report_missing(ld, param_section, param, NULL);
             b->friction_params[p] = NAN;
         } else {
             b->friction_params[p] = param->default_value;
@@ -827,6 +828,8 @@ static void build_prescribed(loader *ld, bk_config *c)
         return;
     }
     entry *lengths = durations ? durations : distances;
+    if (!lengths)
+        return; /* reported above */
     size_t n = (size_t)rates->number;
     if ((size_t)lengths->number != n) {
         report_entry(ld, lengths, "has %zu values, slip_rates has %zu", (size_t)lengths->number, n);
@@ -1022,8 +1025,7 @@ int bk_config_load_string(const char *text, const char *name, const char *const 
                           size_t n_overrides, bk_config **out, bk_error *err)
 {
     *out = NULL;
-    loader ld = {.name = name, .error_rank = LONG_MAX, .err = err, .status = BK_OK, .text = text,
-                 .cursor = text};
+    loader ld = {.name = name, .error_rank = LONG_MAX, .err = err, .status = BK_OK, .cursor = text};
     int first_bad = ini_parse_stream(read_line, &ld, on_pair, &ld);
     if (first_bad > 0)
         report(&ld, first_bad, BK_ERR_CONFIG,

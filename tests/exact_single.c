@@ -13,7 +13,7 @@ static double first_angle(double P, double Q, double r, double theta_min)
     if (M == 0.0 || fabs(r) > M)
         return INFINITY;
     double gamma = atan2(Q, P); /* P sin + Q cos = M sin(theta + gamma) */
-    double base[2] = {asin(r / M), PI - asin(r / M)};
+    const double base[2] = {asin(r / M), PI - asin(r / M)};
     double best = INFINITY;
     for (int b = 0; b < 2; ++b)
         for (int n = -2; n <= 3; ++n) {

@@ -47,8 +47,9 @@ static int run(const char *command, char **output)
         len += got;
         if (cap - len < 2) {
             cap *= 2;
-            buf = realloc(buf, cap);
-            assert_non_null(buf);
+            char *grown = realloc(buf, cap);
+            assert_non_null(grown);
+            buf = grown;
         }
     }
     buf[len] = '\0';

@@ -343,7 +343,7 @@ static velocity_log run_rice_ruina(double stiffness_factor)
     assert_int_equal(bk_config_load_string(text, "rice_ruina.ini", NULL, 0, &c, &err), BK_OK);
     /* Put the spring at the steady friction force, so only the state is perturbed. */
     const bk_block *blk = &c->model->blocks[0];
-    double steady_state[1] = {Dc / V};
+    double steady_state[1] = {Dc / V}; // cppcheck-suppress duplicateExpression ; Dc and V happen to be equal here
     double friction = blk->law->sliding_force(blk->friction_params, blk->normal_force, V, steady_state);
     c->model->driver.start_position = friction / blk->driver_stiffness;
     velocity_log log = {0, 0, V, t_end};

@@ -80,6 +80,7 @@ static void battery(const bk_solver_backend *b, const char *linear_solver)
     /* Restart with three components from the root; run to the stop time. */
     n = 3;
     double z0[3] = {0.0, -omega, 1.0};
+    // cppcheck-suppress unreadVariable ; read through p.root_direction by the back-end
     direction[0] = +1; /* the next crossing rises, half a period on */
     assert_int_equal(b->start(mem, &p, t, z0, atol, n, t + 0.25 * PI / omega, &err), BK_OK);
     double t_start = t;

@@ -1376,12 +1376,14 @@ static int count_phases(hid_t file, const char *path, size_t n_blocks, long *sti
     if (!buf)
         rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
     for (hsize_t start = 0; rc == BK_OK && start < count; start += TRANSITION_BUFFER) {
-        hsize_t n = count - start < TRANSITION_BUFFER ? count - start : TRANSITION_BUFFER;
+        size_t n = (size_t)(count - start);
+        if (n > TRANSITION_BUFFER)
+            n = TRANSITION_BUFFER;
         if (read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
             rc = H5_FAIL(err, "%s: cannot read /transitions", path);
             break;
         }
-        for (size_t k = 0; k < (size_t)n; ++k) {
+        for (size_t k = 0; k < n; ++k) {
             if (buf[k].block < 0 || (size_t)buf[k].block >= n_blocks) {
                 rc = BK_FAIL(err, BK_ERR_HDF5,
                              "%s: /transitions row %llu names block %d, outside 0..%zu", path,
@@ -1817,12 +1819,14 @@ static int export_transitions(hid_t file, const char *path, long block, FILE *ou
     else
         fprintf(out, "# t[s] block[1] from[1] to[1] x[m] v[m/s] force[N]\n");
     for (hsize_t start = 0; rc == BK_OK && start < count; start += TRANSITION_BUFFER) {
-        hsize_t n = count - start < TRANSITION_BUFFER ? count - start : TRANSITION_BUFFER;
+        size_t n = (size_t)(count - start);
+        if (n > TRANSITION_BUFFER)
+            n = TRANSITION_BUFFER;
         if (read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
             rc = H5_FAIL(err, "%s: cannot read /transitions", path);
             break;
         }
-        for (size_t k = 0; k < (size_t)n; ++k) {
+        for (size_t k = 0; k < n; ++k) {
             const bk_transition *t = &buf[k];
             if (block >= 0 && t->block != block)
                 continue;
