@@ -79,15 +79,19 @@ paper: bksim
 # regressions in tests/fuzz/regressions/).
 FUZZ_SECONDS ?= 60
 FUZZ_SRC := $(filter-out src/output/hdf5.c,$(LIB_SRC))
-build-fuzz/fuzz_config: tests/fuzz/fuzz_config.c $(FUZZ_SRC) $(wildcard include/bksim/*.h src/*.h)
+# Two harnesses: fuzz_config (text -> model) and fuzz_run (text -> a short run);
+# make fuzz FUZZ_TARGET=fuzz_run.
+FUZZ_TARGET ?= fuzz_config
+build-fuzz/%: tests/fuzz/%.c $(FUZZ_SRC) $(wildcard include/bksim/*.h src/*.h)
 	@mkdir -p build-fuzz
 	clang -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all $(CPPFLAGS) \
-	    -o $@ tests/fuzz/fuzz_config.c $(FUZZ_SRC) $(LDLIBS)
-fuzz: build-fuzz/fuzz_config
-	@mkdir -p build-fuzz/corpus build-fuzz/artifacts
-	cp configs/*/*.ini tests/fuzz/regressions/* build-fuzz/corpus/ 2>/dev/null || true
-	build-fuzz/fuzz_config -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=20 \
-	    -artifact_prefix=build-fuzz/artifacts/ -dict=tests/fuzz/config.dict build-fuzz/corpus
+	    -o $@ $< $(FUZZ_SRC) $(LDLIBS)
+fuzz: build-fuzz/$(FUZZ_TARGET)
+	@mkdir -p build-fuzz/corpus-$(FUZZ_TARGET) build-fuzz/artifacts
+	cp configs/*/*.ini tests/fuzz/regressions/*.ini build-fuzz/corpus-$(FUZZ_TARGET)/ 2>/dev/null || true
+	build-fuzz/$(FUZZ_TARGET) -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=20 \
+	    -artifact_prefix=build-fuzz/artifacts/$(FUZZ_TARGET)- -dict=tests/fuzz/config.dict \
+	    build-fuzz/corpus-$(FUZZ_TARGET)
 
 clean:
 	rm -rf build build-asan build-fuzz bksim

@@ -129,6 +129,8 @@ static const key_def keys[] = {
      BK_KEY_FIELDS, field_names, NULL, "all"},
     {"output", {"transitions", "", 1, 0, 1, 0, "write the /transitions table"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
     {"output", {"event_rows", "", 1, 0, 1, 0, "add a row at every transition instant"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
+    NUM("output", "checkpoint_interval", "s", 0.0, 0.0, INFINITY, 0,
+        "time between checkpoints, from which `bksim run --restart` continues (0: none)"),
 
     NUM("run", "t_end", "s", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE,
         "end time (runs from 0); in a prescribed scene optional, at most the schedule's length"),
@@ -931,6 +933,7 @@ static bk_config *build(loader *ld)
         o->fields &= ~(unsigned)BK_FIELD_ENERGY; /* no dynamics, no energies */
     o->transitions = (int)value_of(ld, "output", "transitions");
     o->event_rows = (int)value_of(ld, "output", "event_rows");
+    o->checkpoint_interval = value_of(ld, "output", "checkpoint_interval");
     return c;
 }
 
@@ -949,6 +952,10 @@ void bk_config_free(bk_config *config)
     free(config->output.path);
     free(config->source_name);
     free(config->text);
+    free(config->file_text);
+    for (size_t k = 0; k < config->n_overrides; ++k)
+        free(config->overrides[k]);
+    free(config->overrides);
     free(config);
 }
 
@@ -1047,7 +1054,12 @@ int bk_config_load_string(const char *text, const char *name, const char *const 
     if (c && ld.error_rank == LONG_MAX) {
         c->source_name = strdup(name);
         c->text = config_text(text, overrides, n_overrides);
-        if (!c->source_name || !c->text)
+        c->file_text = strdup(text);
+        c->overrides = calloc(n_overrides ? n_overrides : 1, sizeof *c->overrides);
+        int ok = c->source_name && c->text && c->file_text && c->overrides;
+        for (size_t k = 0; ok && k < n_overrides; ++k, ++c->n_overrides)
+            ok = (c->overrides[k] = strdup(overrides[k])) != NULL;
+        if (!ok)
             report(&ld, 0, BK_ERR_NOMEM, "%s: out of memory", name);
     } else if (!c && ld.error_rank == LONG_MAX) {
         report(&ld, 0, BK_ERR_NOMEM, "%s: out of memory", name);

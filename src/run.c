@@ -64,7 +64,22 @@ typedef struct run_ctx {
 
     double elastic0, kinetic0;
     double wall_start;    /* s, monotonic clock at the start */
+    double cpu0;          /* clock() at the start */
+
+    /* checkpoints: forced restarts at multiples of the interval */
+    double checkpoint_interval;
+    long next_checkpoint; /* index k of the next checkpoint time k * interval */
+    bk_run_stats base;    /* counters of the run this one resumed, if any */
 } run_ctx;
+
+/* Next checkpoint time (+inf without checkpoints); always < t_end or +inf. */
+static double checkpoint_time(const run_ctx *ctx)
+{
+    if (ctx->checkpoint_interval <= 0.0)
+        return INFINITY;
+    double t = (double)ctx->next_checkpoint * ctx->checkpoint_interval;
+    return t < ctx->t_end ? t : INFINITY;
+}
 
 /* --- output ---------------------------------------------------------------------------- */
 
@@ -104,8 +119,7 @@ static int emit_row(run_ctx *ctx, double t, int is_event)
     };
     ctx->t_last_row = t;
     ctx->steps_since_row = 0;
-    if (ctx->stats)
-        ctx->stats->rows++;
+    ctx->stats->rows++;
     if (ctx->sink && ctx->sink->sample) {
         int rc = ctx->sink->sample(ctx->sink->self, &sample, ctx->err);
         if (rc != BK_OK)
@@ -159,8 +173,7 @@ static int record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_
                        i, ctx->options.max_transitions_per_instant, ctx->instant_window, t,
                        bk_mode_name(from), bk_mode_name(to), applied_force,
                        bk_scene_static_threshold(scene, i));
-    if (ctx->stats)
-        ctx->stats->transitions++;
+    ctx->stats->transitions++;
     if (!ctx->config->output.transitions || !ctx->sink || !ctx->sink->transition)
         return BK_OK;
     bk_transition tr = {
@@ -195,6 +208,98 @@ static int apply_event(run_ctx *ctx, double t, size_t i, bk_mode_event event)
         return 0;
     int rc = record_transition(ctx, t, i, from, to, force);
     return rc < 0 ? rc : 1;
+}
+
+/* --- checkpoints ----------------------------------------------------------------------- */
+
+static double wall_seconds(void);
+
+/* Counters so far, the resumed run's included. */
+static void collect_stats(const run_ctx *ctx, bk_run_stats *stats, double cpu0)
+{
+    const bk_run_stats *base = &ctx->base;
+    if (ctx->solver) {
+        bk_solver_counters c;
+        ctx->backend->counters(ctx->solver, &c);
+        stats->steps = base->steps + c.steps;
+        stats->rhs_evals = base->rhs_evals + c.rhs_evals;
+        stats->root_evals = base->root_evals + c.root_evals;
+        stats->err_test_fails = base->err_test_fails + c.err_test_fails;
+        stats->nonlin_iters = base->nonlin_iters + c.nonlin_iters;
+    }
+    stats->t_reached = ctx->t_last_row;
+    stats->wall_time = base->wall_time + (wall_seconds() - ctx->wall_start);
+    stats->cpu_time = base->cpu_time + (double)(clock() - (clock_t)cpu0) / CLOCKS_PER_SEC;
+}
+
+/* Record the state at t (the scene unpacked there) and advance to the next checkpoint. */
+static int emit_checkpoint(run_ctx *ctx, double t)
+{
+    ctx->next_checkpoint++;
+    if (!ctx->sink || !ctx->sink->checkpoint)
+        return BK_OK;
+    bk_scene *scene = &ctx->scene;
+    bk_checkpoint cp = {
+        .t = t,
+        .n_blocks = scene->n,
+        .n_state = ctx->model->n_friction_state,
+        .mode = scene->mode,
+        .x = scene->x,
+        .v = scene->v,
+        .state = scene->state,
+        .t_switch = scene->t_switch,
+        .from_rest = scene->from_rest,
+        .extremum_armed = scene->extremum_armed,
+        .last_transition = ctx->last_transition,
+        .instant_count = ctx->instant_count,
+        .next_sample = ctx->next_sample,
+        .work_driver = scene->work,
+        .dissipation = scene->dissipation,
+        .elastic_initial = ctx->elastic0,
+        .kinetic_initial = ctx->kinetic0,
+        .t_last_row = ctx->t_last_row,
+        .steps_since_row = ctx->steps_since_row,
+    };
+    cp.stats = *ctx->stats;
+    collect_stats(ctx, &cp.stats, ctx->cpu0);
+    int rc = ctx->sink->checkpoint(ctx->sink->self, &cp, ctx->err);
+    return rc == BK_OK ? BK_OK : (rc < 0 ? rc : BK_ERR_SINK);
+}
+
+int bk_checkpoint_alloc(bk_checkpoint *cp, size_t n_blocks, size_t n_state)
+{
+    memset(cp, 0, sizeof *cp);
+    cp->n_blocks = n_blocks;
+    cp->n_state = n_state;
+    cp->mode = calloc(n_blocks, sizeof *cp->mode);
+    cp->x = calloc(n_blocks, sizeof *cp->x);
+    cp->v = calloc(n_blocks, sizeof *cp->v);
+    cp->state = calloc(n_state + 1, sizeof *cp->state);
+    cp->t_switch = calloc(n_blocks, sizeof *cp->t_switch);
+    cp->from_rest = calloc(n_blocks, sizeof *cp->from_rest);
+    cp->extremum_armed = calloc(n_blocks, sizeof *cp->extremum_armed);
+    cp->last_transition = calloc(n_blocks, sizeof *cp->last_transition);
+    cp->instant_count = calloc(n_blocks, sizeof *cp->instant_count);
+    if (!cp->mode || !cp->x || !cp->v || !cp->state || !cp->t_switch || !cp->from_rest ||
+        !cp->extremum_armed || !cp->last_transition || !cp->instant_count) {
+        bk_checkpoint_free(cp);
+        return BK_ERR_NOMEM;
+    }
+    return BK_OK;
+}
+
+void bk_checkpoint_free(bk_checkpoint *cp)
+{
+    free(cp->mode);
+    free(cp->x);
+    free(cp->v);
+    free(cp->state);
+    free(cp->t_switch);
+    free(cp->from_rest);
+    free(cp->extremum_armed);
+    free(cp->last_transition);
+    free(cp->instant_count);
+    memset(cp, 0, sizeof *cp);
 }
 
 /* --- integration ----------------------------------------------------------------------- */
@@ -384,12 +489,13 @@ static int integrate(run_ctx *ctx, double *t)
     ctx->problem.n_pairs = ctx->model->n_friction_state == 0 ? scene->n_active : 0;
     ctx->problem.pair_mass = scene->active_mass;
     ctx->problem.affine = scene->affine;
+    double t_checkpoint = checkpoint_time(ctx);
+    double t_stop = t_checkpoint < ctx->t_end ? t_checkpoint : ctx->t_end;
     int rc = ctx->backend->start(ctx->solver, &ctx->problem, *t, ctx->y, ctx->atol, scene->n_y,
-                                 ctx->t_end, ctx->err);
+                                 t_stop, ctx->err);
     if (rc != BK_OK)
         return rc;
-    if (ctx->stats)
-        ctx->stats->integrator_starts++;
+    ctx->stats->integrator_starts++;
     for (;;) {
         double t_reached;
         int step = ctx->backend->step(ctx->solver, &t_reached, ctx->y, ctx->err);
@@ -421,8 +527,9 @@ static int integrate(run_ctx *ctx, double *t)
             return rc;
         if (step == BK_STEP_STOP) {
             bk_scene_unpack(scene, t_reached, ctx->y);
-            *t = ctx->t_end;
-            return BK_OK;
+            *t = t_stop;
+            /* A checkpoint: the main loop restarts here, as a resumed run will. */
+            return t_stop < ctx->t_end ? emit_checkpoint(ctx, t_stop) : BK_OK;
         }
         if ((rc = report_progress(ctx, t_reached)) != BK_OK)
             return rc; /* every step, so that a wall-clock limit bites inside long segments */
@@ -483,14 +590,16 @@ static int jump(run_ctx *ctx, double *t)
         if (ti < t_fail)
             t_fail = ti;
     }
-    double t_next = t_fail < ctx->t_end ? t_fail : ctx->t_end;
+    double t_checkpoint = checkpoint_time(ctx);
+    double t_stop = t_checkpoint < ctx->t_end ? t_checkpoint : ctx->t_end;
+    double t_next = t_fail < t_stop ? t_fail : t_stop;
     double d0 = bk_driver_position(&model->driver, t0);
     double work0 = scene->work;
     int rc;
     /* Samples while everything holds still; only the driver and its work change. */
     for (;;) {
         double ts = sample_time(ctx, ctx->next_sample);
-        if (ctx->next_sample < 0 || ts > t_next || (ts == t_next && t_fail <= ctx->t_end && ctx->event_rows))
+        if (ctx->next_sample < 0 || ts > t_next || (ts == t_next && t_fail <= t_stop && ctx->event_rows))
             break;
         scene->work = work0 + stuck_work(ctx, d0, bk_driver_position(&model->driver, ts));
         if ((rc = emit_row(ctx, ts, 0)) != BK_OK)
@@ -498,11 +607,10 @@ static int jump(run_ctx *ctx, double *t)
         ctx->next_sample = ts >= ctx->t_end ? -1 : ctx->next_sample + 1;
     }
     scene->work = work0 + stuck_work(ctx, d0, bk_driver_position(&model->driver, t_next));
-    if (ctx->stats)
-        ctx->stats->stuck_jumps++;
+    ctx->stats->stuck_jumps++;
     *t = t_next;
-    if (t_fail > ctx->t_end)
-        return BK_OK;
+    if (t_fail > t_stop)
+        return t_stop < ctx->t_end ? emit_checkpoint(ctx, t_stop) : BK_OK;
     /* Every block whose breakaway falls on this instant (to rounding) slips now. */
     double tolerance = 8.0 * DBL_EPSILON * fabs(t_fail);
     int changed = 0;
@@ -632,21 +740,64 @@ static double wall_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* The state of a checkpoint, back into the scene (x_ref = x: the run restarts there). */
+static int resume(run_ctx *ctx, const bk_checkpoint *cp)
+{
+    bk_scene *scene = &ctx->scene;
+    size_t n = scene->n, n_state = ctx->model->n_friction_state;
+    if (cp->n_blocks != n || cp->n_state != n_state)
+        return BK_FAIL(ctx->err, BK_ERR_INVALID,
+                       "checkpoint of %zu blocks and %zu friction states does not fit this config (%zu, %zu)",
+                       cp->n_blocks, cp->n_state, n, n_state);
+    memcpy(scene->mode, cp->mode, n * sizeof *scene->mode);
+    memcpy(scene->x, cp->x, n * sizeof *scene->x);
+    memcpy(scene->x_ref, cp->x, n * sizeof *scene->x_ref);
+    memcpy(scene->v, cp->v, n * sizeof *scene->v);
+    memcpy(scene->state, cp->state, n_state * sizeof *scene->state);
+    memcpy(scene->t_switch, cp->t_switch, n * sizeof *scene->t_switch);
+    memcpy(scene->from_rest, cp->from_rest, n * sizeof *scene->from_rest);
+    memcpy(scene->extremum_armed, cp->extremum_armed, n * sizeof *scene->extremum_armed);
+    memcpy(ctx->last_transition, cp->last_transition, n * sizeof *ctx->last_transition);
+    memcpy(ctx->instant_count, cp->instant_count, n * sizeof *ctx->instant_count);
+    scene->work = cp->work_driver;
+    scene->dissipation = cp->dissipation;
+    ctx->elastic0 = cp->elastic_initial;
+    ctx->kinetic0 = cp->kinetic_initial;
+    ctx->next_sample = cp->next_sample;
+    ctx->t_last_row = cp->t_last_row;
+    ctx->steps_since_row = cp->steps_since_row;
+    ctx->base = cp->stats;
+    *ctx->stats = cp->stats;
+    if (ctx->checkpoint_interval > 0.0)
+        ctx->next_checkpoint = (long)llround(cp->t / ctx->checkpoint_interval) + 1;
+    return BK_OK;
+}
+
 int bk_run(const bk_config *config, const bk_sink *sink, bk_run_stats *stats,
            bk_progress_fn progress, void *progress_user, bk_error *err)
 {
-    if (config->prescribed)
+    return bk_run_from(config, NULL, sink, stats, progress, progress_user, err);
+}
+
+int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sink *sink,
+                bk_run_stats *stats, bk_progress_fn progress, void *progress_user, bk_error *err)
+{
+    if (config->prescribed) {
+        if (from)
+            return BK_FAIL(err, BK_ERR_INVALID, "prescribed-motion scenes have no checkpoints");
         return bk_run_prescribed(config, sink, stats, progress, progress_user, err);
+    }
     double wall0 = wall_seconds();
     clock_t cpu0 = clock();
     gsl_set_error_handler_off();
     run_ctx ctx;
     memset(&ctx, 0, sizeof ctx);
+    bk_run_stats local_stats;
     ctx.config = config;
     ctx.model = config->model;
     ctx.sink = sink;
     ctx.err = err;
-    ctx.stats = stats;
+    ctx.stats = stats ? stats : &local_stats;
     ctx.progress = progress;
     ctx.progress_user = progress_user;
     ctx.options = config->solver;
@@ -655,10 +806,11 @@ int bk_run(const bk_config *config, const bk_sink *sink, bk_run_stats *stats,
     ctx.event_rows = config->output.event_rows;
     ctx.next_sample = 0;
     ctx.wall_start = wall0;
-    if (stats) {
-        memset(stats, 0, sizeof *stats);
-        snprintf(stats->method, sizeof stats->method, "%s", config->solver.method);
-    }
+    ctx.cpu0 = (double)cpu0;
+    ctx.checkpoint_interval = config->output.checkpoint_interval;
+    ctx.next_checkpoint = 1;
+    memset(ctx.stats, 0, sizeof *ctx.stats);
+    snprintf(ctx.stats->method, sizeof ctx.stats->method, "%s", config->solver.method);
 
     ctx.backend = bk_solver_backend_find(config->solver.method);
     if (!ctx.backend)
@@ -683,6 +835,7 @@ int bk_run(const bk_config *config, const bk_sink *sink, bk_run_stats *stats,
     }
     for (size_t i = 0; i < n; ++i)
         ctx.last_transition[i] = -INFINITY;
+    /* Scales come from the initial state in a resumed run too, so both runs use the same. */
     resolve_scales(&ctx);
     ctx.problem = (bk_ode_problem){
         .user = &ctx.scene,
@@ -697,15 +850,21 @@ int bk_run(const bk_config *config, const bk_sink *sink, bk_run_stats *stats,
     }
 
     double t = 0.0;
-    int moved;
-    if ((rc = initial_modes(&ctx, &moved)) != BK_OK)
-        goto done;
-    double driver0 = bk_driver_position(&ctx.model->driver, 0.0);
-    ctx.elastic0 = bk_model_elastic_energy(ctx.model, ctx.scene.x, driver0);
-    ctx.kinetic0 = bk_model_kinetic_energy(ctx.model, ctx.scene.v);
-    if ((rc = emit_row(&ctx, 0.0, moved)) != BK_OK)
-        goto done;
-    ctx.next_sample = 1;
+    if (from) {
+        if ((rc = resume(&ctx, from)) != BK_OK)
+            goto done;
+        t = from->t;
+    } else {
+        int moved;
+        if ((rc = initial_modes(&ctx, &moved)) != BK_OK)
+            goto done;
+        double driver0 = bk_driver_position(&ctx.model->driver, 0.0);
+        ctx.elastic0 = bk_model_elastic_energy(ctx.model, ctx.scene.x, driver0);
+        ctx.kinetic0 = bk_model_kinetic_energy(ctx.model, ctx.scene.v);
+        if ((rc = emit_row(&ctx, 0.0, moved)) != BK_OK)
+            goto done;
+        ctx.next_sample = 1;
+    }
     while (t < ctx.t_end) {
         rc = needs_integration(&ctx.scene) ? integrate(&ctx, &t) : jump(&ctx, &t);
         if (rc != BK_OK)
@@ -713,31 +872,18 @@ int bk_run(const bk_config *config, const bk_sink *sink, bk_run_stats *stats,
     }
 
 done:
-    if (stats) {
-        if (ctx.solver) {
-            bk_solver_counters c;
-            ctx.backend->counters(ctx.solver, &c);
-            stats->steps = c.steps;
-            stats->rhs_evals = c.rhs_evals;
-            stats->root_evals = c.root_evals;
-            stats->err_test_fails = c.err_test_fails;
-            stats->nonlin_iters = c.nonlin_iters;
-        }
-        stats->t_reached = ctx.t_last_row;
-        if (ctx.scene.x) {
-            double d = bk_driver_position(&ctx.model->driver, ctx.t_last_row);
-            stats->work_driver = ctx.scene.work;
-            stats->dissipation = ctx.scene.dissipation;
-            stats->elastic_change = bk_model_elastic_energy(ctx.model, ctx.scene.x, d) - ctx.elastic0;
-            stats->kinetic_change = bk_model_kinetic_energy(ctx.model, ctx.scene.v) - ctx.kinetic0;
-            double scale = fmax(fmax(fabs(stats->work_driver), fabs(stats->dissipation)),
-                                fmax(fabs(stats->elastic_change), fabs(stats->kinetic_change)));
-            double residual = stats->work_driver - stats->elastic_change - stats->kinetic_change -
-                              stats->dissipation;
-            stats->energy_residual = scale > 0.0 ? residual / scale : 0.0;
-        }
-        stats->wall_time = wall_seconds() - wall0;
-        stats->cpu_time = (double)(clock() - cpu0) / CLOCKS_PER_SEC;
+    collect_stats(&ctx, ctx.stats, (double)cpu0);
+    if (ctx.scene.x) {
+        bk_run_stats *st = ctx.stats;
+        double d = bk_driver_position(&ctx.model->driver, ctx.t_last_row);
+        st->work_driver = ctx.scene.work;
+        st->dissipation = ctx.scene.dissipation;
+        st->elastic_change = bk_model_elastic_energy(ctx.model, ctx.scene.x, d) - ctx.elastic0;
+        st->kinetic_change = bk_model_kinetic_energy(ctx.model, ctx.scene.v) - ctx.kinetic0;
+        double scale = fmax(fmax(fabs(st->work_driver), fabs(st->dissipation)),
+                            fmax(fabs(st->elastic_change), fabs(st->kinetic_change)));
+        double residual = st->work_driver - st->elastic_change - st->kinetic_change - st->dissipation;
+        st->energy_residual = scale > 0.0 ? residual / scale : 0.0;
     }
     free_ctx(&ctx);
     return rc;

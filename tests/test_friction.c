@@ -347,7 +347,7 @@ static velocity_log run_rice_ruina(double stiffness_factor)
     double friction = blk->law->sliding_force(blk->friction_params, blk->normal_force, V, steady_state);
     c->model->driver.start_position = friction / blk->driver_stiffness;
     velocity_log log = {0, 0, V, t_end};
-    bk_sink sink = {&log, log_velocity, NULL};
+    bk_sink sink = {.self = &log, .sample = log_velocity, .transition = NULL};
     bk_run_stats stats;
     int rc = bk_run(c, &sink, &stats, NULL, NULL, &err);
     if (rc != BK_OK)

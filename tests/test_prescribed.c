@@ -61,7 +61,7 @@ static int run_text(const char *text, rows *r, bk_error *err)
     int rc = bk_config_load_string(text, "p.ini", NULL, 0, &c, err);
     if (rc != BK_OK)
         return rc;
-    bk_sink sink = {r, keep, count_transition};
+    bk_sink sink = {.self = r, .sample = keep, .transition = count_transition};
     rc = bk_run(c, &sink, NULL, NULL, NULL, err);
     bk_config_free(c);
     return rc;

@@ -133,7 +133,7 @@ static void free_config(bk_config *c)
 static int run_spec(const scene_spec *spec, recorder *r, bk_run_stats *stats, bk_error *err)
 {
     bk_config *c = make_config(spec);
-    bk_sink sink = {r, record_sample, record_transition};
+    bk_sink sink = {.self = r, .sample = record_sample, .transition = record_transition};
     int rc = bk_run(c, &sink, stats, NULL, NULL, err);
     free_config(c);
     return rc;
@@ -352,7 +352,7 @@ static void check_energy(size_t n, bk_spring spring, bk_boundary boundary)
             c->model->blocks[i].friction_params[1] = 0.45 + 0.01 * (double)(i % 5);
         }
         recorder r = {0};
-        bk_sink sink = {&r, record_sample, record_transition};
+        bk_sink sink = {.self = &r, .sample = record_sample, .transition = record_transition};
         bk_run_stats stats;
         bk_error err = {0};
         assert_int_equal(bk_run(c, &sink, &stats, NULL, NULL, &err), BK_OK);
@@ -417,7 +417,7 @@ static void test_reversal(void **state)
     /* Start sliding fast with no driver motion: the spring swings it back past its threshold. */
     c->model->blocks[0].v_init = 0.5;
     recorder r = {0};
-    bk_sink sink = {&r, record_sample, record_transition};
+    bk_sink sink = {.self = &r, .sample = record_sample, .transition = record_transition};
     bk_error err = {0};
     assert_int_equal(bk_run(c, &sink, NULL, NULL, NULL, &err), BK_OK);
     assert_true(r.n_transitions >= 2);
@@ -440,7 +440,7 @@ static void test_chattering_guard(void **state)
     /* Stop and breakaway 0.2 ms apart count as one instant in a 1 ms window. */
     c->solver.instant_window = 1e-3;
     recorder r = {0};
-    bk_sink sink = {&r, record_sample, record_transition};
+    bk_sink sink = {.self = &r, .sample = record_sample, .transition = record_transition};
     bk_error err = {0};
     assert_int_equal(bk_run(c, &sink, NULL, NULL, NULL, &err), BK_ERR_ZENO);
     assert_non_null(strstr(err.message, "block 0"));
@@ -463,7 +463,7 @@ static void test_interrupt(void **state)
     scene_spec spec = paper_case(0.5, BK_SPRING_LINEAR, 1e-8);
     bk_config *c = make_config(&spec);
     recorder r = {0};
-    bk_sink sink = {&r, record_sample, record_transition};
+    bk_sink sink = {.self = &r, .sample = record_sample, .transition = record_transition};
     bk_error err = {0};
     assert_int_equal(bk_run(c, &sink, NULL, stop_at_one_second, NULL, &err), BK_ERR_INTERRUPTED);
     assert_true(r.last_t < 1.2);
@@ -515,7 +515,7 @@ static void test_per_block_laws(void **state)
     assert_int_equal(m->blocks[1].state_offset, 0);
     assert_int_equal(m->blocks[3].state_offset, 1);
     recorder r = {0};
-    bk_sink sink = {&r, record_sample, record_transition};
+    bk_sink sink = {.self = &r, .sample = record_sample, .transition = record_transition};
     bk_run_stats stats;
     int rc = bk_run(c, &sink, &stats, NULL, NULL, &err);
     if (rc != BK_OK)

@@ -44,6 +44,7 @@ typedef struct bk_output_options {
     unsigned fields;   /* BK_FIELD_* mask; default all */
     int transitions;   /* write /transitions; default 1 */
     int event_rows;    /* add a row at every transition instant; default 1 */
+    double checkpoint_interval; /* s between checkpoints (restart points); 0 = none (default) */
 } bk_output_options;
 
 /* A prescribed-motion scene (no dynamics): one block slides at a piecewise-constant slip
@@ -64,6 +65,9 @@ typedef struct bk_config {
                                  0 = no limit (default) */
     char *source_name;        /* config file path (or the name given to load_string), owned */
     char *text;               /* config text with the --set overrides appended, owned */
+    char **overrides;         /* the --set overrides, owned (kept to reload the same config) */
+    size_t n_overrides;
+    char *file_text;          /* the config as read, without the overrides, owned */
 } bk_config;
 
 /* Load and validate a config file.  overrides are "section.key=value" strings applied after

@@ -35,6 +35,15 @@ int bk_h5_writer_finish(bk_h5_writer *writer, const bk_run_stats *stats, bk_erro
  * close, and leave it as "<path>.part".  Frees the writer.  stats may be NULL. */
 void bk_h5_writer_abandon(bk_h5_writer *writer, const char *reason, const bk_run_stats *stats);
 
+/* Reopen the output of a run that stopped (<path>.part, or path given as the .part itself)
+ * to continue it from its last checkpoint: reloads the config it stored (file text and
+ * --set overrides), reads the checkpoint into *checkpoint (free with bk_checkpoint_free),
+ * truncates every dataset to the rows written up to the checkpoint, and returns a writer
+ * that appends from there and renames to <path> when finished.  On failure nothing is
+ * returned and the file is unchanged. */
+int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config,
+                        bk_checkpoint *checkpoint, bk_error *err);
+
 /* Summary of an output file: parameters, stick/slip phase counts, solver stats, and the
  * integrity check below.  Returns BK_OK for a complete, intact file, BK_INCOMPLETE for an
  * intact file of a run that did not finish, BK_ERR_DAMAGED (message says what) or another

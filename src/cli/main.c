@@ -23,6 +23,8 @@ static const char *const usage_text =
     "  run CONFIG [-o OUT] [--set section.key=value]... [--quiet]\n"
     "                       simulate the scene CONFIG describes, write HDF5 to OUT\n"
     "                       (default: [output] path)\n"
+    "  run --restart OUT.h5[.part] [--quiet]\n"
+    "                       continue a stopped run from its last checkpoint\n"
     "  check CONFIG [--set section.key=value]...\n"
     "                       validate CONFIG without running\n"
     "  info OUT.h5          summarise an output file\n"
@@ -35,8 +37,12 @@ static const char *const usage_text =
 
 static const char *const run_help =
     "usage: bksim run CONFIG [-o OUT] [--set section.key=value]... [--quiet]\n"
+    "       bksim run --restart OUT.h5[.part] [--quiet]\n"
     "\n"
     "Runs the scene described by the INI file CONFIG and writes an HDF5 time series.\n"
+    "  --restart OUT      continue the stopped run whose output is OUT.part from its last\n"
+    "                     checkpoint ([output] checkpoint_interval), with the config stored\n"
+    "                     in the file; rows after the checkpoint are recomputed\n"
     "  -o, --output OUT   output path (overrides [output] path)\n"
     "  --set S.K=V        override key K of section S after reading CONFIG; S may be\n"
     "                     block.3 or friction.3 for one block (repeatable)\n"
@@ -104,6 +110,7 @@ static int usage_error(const char *command, const char *fmt, ...)
 /* Options shared by run and check. */
 typedef struct config_args {
     const char *config_path;
+    const char *restart;
     const char *output;
     const char **overrides;
     size_t n_overrides;
@@ -133,6 +140,10 @@ static int parse_config_args(const char *command, int argc, char **argv, config_
             args->output = argv[++i];
         } else if (allow_output && (strcmp(a, "-q") == 0 || strcmp(a, "--quiet") == 0)) {
             args->quiet = 1;
+        } else if (allow_output && strcmp(a, "--restart") == 0) {
+            if (i + 1 >= argc)
+                return usage_error(command, "%s needs the output file of the stopped run", a);
+            args->restart = argv[++i];
         } else if (a[0] == '-' && a[1] != '\0') {
             return usage_error(command, "unknown option '%s'", a);
         } else if (!args->config_path) {
@@ -140,6 +151,12 @@ static int parse_config_args(const char *command, int argc, char **argv, config_
         } else {
             return usage_error(command, "unexpected argument '%s'", a);
         }
+    }
+    if (args->restart) {
+        if (args->config_path || args->n_overrides || args->output)
+            return usage_error(command, "%s", "--restart takes no CONFIG, -o or --set: the run continues "
+                                              "with the config stored in its file");
+        return 0;
     }
     if (!args->config_path)
         return usage_error(command, "%s", "missing CONFIG");
@@ -169,7 +186,7 @@ static int prepare(const char *command, const char *help, int argc, char **argv,
         return -1;
     }
     int status = parse_config_args(command, argc, argv, args);
-    if (status == 0)
+    if (status == 0 && !args->restart)
         status = load_config(args, config);
     return status;
 }
@@ -240,25 +257,42 @@ static int cmd_run(int argc, char **argv)
         free(args.overrides);
         return status;
     }
-    const char *path = args.output ? args.output : config->output.path;
     bk_error err = {0};
     bk_h5_writer *writer = NULL;
-    if (bk_h5_writer_open(&writer, config, path, &err) != BK_OK) {
+    bk_checkpoint checkpoint;
+    memset(&checkpoint, 0, sizeof checkpoint);
+    const char *path = args.output ? args.output : config ? config->output.path : NULL;
+    char *restart_path = NULL;
+    int opened;
+    if (args.restart) {
+        opened = bk_h5_writer_resume(&writer, args.restart, &config, &checkpoint, &err);
+        /* The final name: the .part without its suffix. */
+        size_t len = strlen(args.restart);
+        restart_path = len > 5 && strcmp(args.restart + len - 5, ".part") == 0 ? strndup(args.restart, len - 5)
+                                                                                 : strdup(args.restart);
+        path = restart_path;
+    } else {
+        opened = bk_h5_writer_open(&writer, config, path, &err);
+    }
+    if (opened != BK_OK) {
         fprintf(stderr, "%s\n", err.message);
         bk_config_free(config);
         free(args.overrides);
-        return EXIT_RUN_FAILED;
+        free(restart_path);
+        return opened == BK_ERR_INVALID || opened == BK_ERR_CONFIG ? EXIT_USAGE : EXIT_RUN_FAILED;
     }
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
     progress_state progress = {!args.quiet && isatty(STDERR_FILENO), now_seconds(), 0.0, 0};
     bk_sink sink = bk_h5_writer_sink(writer);
     bk_run_stats stats;
-    int rc = bk_run(config, &sink, &stats, show_progress, &progress, &err);
+    int rc = bk_run_from(config, args.restart ? &checkpoint : NULL, &sink, &stats, show_progress,
+                         &progress, &err);
+    bk_checkpoint_free(&checkpoint);
     if (progress.printed)
         fputs("\n", stderr);
     if (rc != BK_OK) {
-        fprintf(stderr, "%s: %s\n", args.config_path, err.message);
+        fprintf(stderr, "%s: %s\n", args.restart ? args.restart : args.config_path, err.message);
         bk_h5_writer_abandon(writer, err.message, &stats);
         fprintf(stderr, "bksim: partial output left in %s.part (complete = 0)\n", path);
         status = EXIT_RUN_FAILED;
@@ -273,6 +307,7 @@ static int cmd_run(int argc, char **argv)
     }
     bk_config_free(config);
     free(args.overrides);
+    free(restart_path);
     return status;
 }
 

@@ -563,6 +563,24 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
         write_double_attr(w->file, "t_reached", 0.0) < 0 ||
         write_string_attr(w->file, "attribute_units", "t_end: s, t_reached: s") < 0)
         return H5_FAIL(err, "%s: cannot write root attributes", w->part);
+    /* What a restart needs to load the same config again: the file as read and the --set
+     * overrides (the `config` attribute shows them only as comments). */
+    size_t len = 1;
+    for (size_t k = 0; k < config->n_overrides; ++k)
+        len += strlen(config->overrides[k]) + 1;
+    char *overrides = calloc(len, 1);
+    if (!overrides)
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", w->part);
+    for (size_t k = 0; k < config->n_overrides; ++k) {
+        strcat(overrides, config->overrides[k]);
+        strcat(overrides, "\n");
+    }
+    herr_t stored = write_string_attr(w->file, "config_file", config->file_text ? config->file_text : config->text);
+    if (stored >= 0)
+        stored = write_string_attr(w->file, "overrides", overrides);
+    free(overrides);
+    if (stored < 0)
+        return H5_FAIL(err, "%s: cannot write root attributes", w->part);
 
     size_t widest = model->n_blocks > n_state ? model->n_blocks : n_state;
     size_t rows = CHUNK_BYTES / (widest * sizeof(double));
@@ -824,9 +842,295 @@ static int sink_transition(void *self, const bk_transition *transition, bk_error
     return w->trans_buffered == TRANSITION_BUFFER ? flush_transitions(w, err) : BK_OK;
 }
 
+/* ------------------------------------------------------------------- checkpoints --- */
+
+static herr_t write_stats(hid_t file, const bk_run_stats *stats);
+
+/* A fixed 1-D array in group, created on first use and overwritten in place after. */
+static herr_t put_array(hid_t group, const char *name, hid_t file_type, hid_t mem_type, size_t n,
+                        const void *data)
+{
+    hid_t dset;
+    if (H5Lexists(group, name, H5P_DEFAULT) > 0) {
+        dset = H5Dopen2(group, name, H5P_DEFAULT);
+    } else {
+        hsize_t dims[1] = {n ? n : 1};
+        hid_t space = H5Screate_simple(1, dims, NULL);
+        dset = space < 0 ? H5I_INVALID_HID
+                         : H5Dcreate2(group, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+        CLOSE_IDS(0, space);
+    }
+    herr_t rc = dset < 0 ? -1 : n ? H5Dwrite(dset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) : 0;
+    CLOSE_IDS(rc, dset);
+    return rc;
+}
+
+static herr_t get_array(hid_t group, const char *name, hid_t mem_type, size_t n, void *data)
+{
+    if (n == 0)
+        return 0;
+    hid_t dset = H5Dopen2(group, name, H5P_DEFAULT);
+    hid_t space = dset < 0 ? H5I_INVALID_HID : H5Dget_space(dset);
+    herr_t rc = -1;
+    if (space >= 0 && (size_t)H5Sget_simple_extent_npoints(space) == n)
+        rc = H5Dread(dset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+    CLOSE_IDS(rc, space, dset);
+    return rc;
+}
+
+#define CHECKPOINT_ARRAYS(X)                                                               \
+    X("mode", H5T_STD_I8LE, H5T_NATIVE_INT8, n, mode)                                       \
+    X("x", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, x)                                         \
+    X("v", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, v)                                         \
+    X("friction_state", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, cp->n_state, state)              \
+    X("t_switch", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, t_switch)                           \
+    X("from_rest", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, from_rest)                            \
+    X("extremum_armed", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, extremum_armed)                  \
+    X("last_transition", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, last_transition)             \
+    X("instant_count", H5T_STD_I64LE, H5T_NATIVE_LONG, n, instant_count)
+
+#define CHECKPOINT_SCALARS(X)                                                              \
+    X("t", t) X("work_driver", work_driver) X("dissipation", dissipation)                  \
+    X("elastic_initial", elastic_initial) X("kinetic_initial", kinetic_initial)            \
+    X("t_last_row", t_last_row)
+
+/* Rows up to the checkpoint are flushed first, so a restart truncates to what is on disk. */
+static int sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
+{
+    bk_h5_writer *w = self;
+    if (w->failed)
+        return BK_FAIL(err, BK_ERR_HDF5, "%s: an earlier write failed; no checkpoint", w->part);
+    int rc = flush_all(w, err);
+    if (rc != BK_OK)
+        return rc;
+    size_t n = cp->n_blocks;
+    hid_t group = H5Lexists(w->file, "checkpoint", H5P_DEFAULT) > 0
+                      ? H5Gopen2(w->file, "checkpoint", H5P_DEFAULT)
+                      : H5Gcreate2(w->file, "checkpoint", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t ok = group < 0 ? -1 : 0;
+#define PUT(name, file_type, mem_type, count, field)                                       \
+    if (ok >= 0)                                                                           \
+        ok = put_array(group, name, file_type, mem_type, count, cp->field);
+    CHECKPOINT_ARRAYS(PUT)
+#undef PUT
+#define PUT(name, field)                                                                   \
+    if (ok >= 0)                                                                           \
+        ok = write_double_attr(group, name, cp->field);
+    CHECKPOINT_SCALARS(PUT)
+#undef PUT
+    if (ok >= 0)
+        ok = write_long_attr(group, "next_sample", cp->next_sample);
+    if (ok >= 0)
+        ok = write_long_attr(group, "steps_since_row", cp->steps_since_row);
+    if (ok >= 0)
+        ok = write_long_attr(group, "rows", (long long)w->rows_written);
+    if (ok >= 0)
+        ok = write_long_attr(group, "transition_rows", (long long)w->trans_written);
+    if (ok >= 0)
+        ok = write_stats(group, &cp->stats);
+    if (ok >= 0)
+        ok = describe(group, "t: s, x: m, v: m/s, t_switch: s, last_transition: s, energies: J",
+                      "the state a restart (bksim run --restart) continues from");
+    CLOSE_IDS(ok, group);
+    if (ok < 0 || H5Fflush(w->file, H5F_SCOPE_LOCAL) < 0) {
+        w->failed = 1;
+        return H5_FAIL(err, "%s: cannot write /checkpoint", w->part);
+    }
+    return BK_OK;
+}
+
+/* The counters a checkpoint carries, from its stats group. */
+static herr_t read_stats(hid_t group, bk_run_stats *stats)
+{
+    hid_t g = H5Gopen2(group, "stats", H5P_DEFAULT);
+    if (g < 0)
+        return -1;
+    herr_t rc = 0;
+    for (size_t i = 0; rc >= 0 && i < N_STATS; ++i) {
+        char *field = (char *)stats + STATS[i].offset;
+        if (STATS[i].is_long) {
+            long long value = 0;
+            rc = read_numeric_attr(g, STATS[i].name, H5T_NATIVE_LLONG, &value);
+            long as_long = (long)value;
+            memcpy(field, &as_long, sizeof as_long);
+        } else {
+            rc = read_numeric_attr(g, STATS[i].name, H5T_NATIVE_DOUBLE, field);
+        }
+    }
+    char *method = read_string_attr(g, "method");
+    if (method)
+        snprintf(stats->method, sizeof stats->method, "%s", method);
+    free(method);
+    CLOSE_IDS(rc, g);
+    return rc;
+}
+
+static int read_checkpoint(hid_t file, const char *path, const bk_config *config, bk_checkpoint *cp,
+                           hsize_t *rows, hsize_t *transition_rows, bk_error *err)
+{
+    if (H5Lexists(file, "checkpoint", H5P_DEFAULT) <= 0)
+        return BK_FAIL(err, BK_ERR_INVALID, "%s: no checkpoint to restart from (run with [output] "
+                       "checkpoint_interval > 0)", path);
+    size_t n = config->model->n_blocks;
+    if (bk_checkpoint_alloc(cp, n, config->model->n_friction_state) != BK_OK)
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    hid_t group = H5Gopen2(file, "checkpoint", H5P_DEFAULT);
+    herr_t ok = group < 0 ? -1 : 0;
+#define GET(name, file_type, mem_type, count, field)                                       \
+    if (ok >= 0)                                                                           \
+        ok = get_array(group, name, mem_type, count, cp->field);
+    CHECKPOINT_ARRAYS(GET)
+#undef GET
+#define GET(name, field)                                                                   \
+    if (ok >= 0)                                                                           \
+        ok = read_numeric_attr(group, name, H5T_NATIVE_DOUBLE, &cp->field);
+    CHECKPOINT_SCALARS(GET)
+#undef GET
+    long long next_sample = 0, steps = 0, r = 0, tr = 0;
+    if (ok >= 0)
+        ok = read_numeric_attr(group, "next_sample", H5T_NATIVE_LLONG, &next_sample);
+    if (ok >= 0)
+        ok = read_numeric_attr(group, "steps_since_row", H5T_NATIVE_LLONG, &steps);
+    if (ok >= 0)
+        ok = read_numeric_attr(group, "rows", H5T_NATIVE_LLONG, &r);
+    if (ok >= 0)
+        ok = read_numeric_attr(group, "transition_rows", H5T_NATIVE_LLONG, &tr);
+    if (ok >= 0)
+        ok = read_stats(group, &cp->stats);
+    CLOSE_IDS(ok, group);
+    if (ok < 0) {
+        bk_checkpoint_free(cp);
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /checkpoint cannot be read", path);
+    }
+    cp->next_sample = (long)next_sample;
+    cp->steps_since_row = (long)steps;
+    *rows = (hsize_t)r;
+    *transition_rows = (hsize_t)tr;
+    return BK_OK;
+}
+
+/* Truncate dset to rows (dropping what was written after the checkpoint). */
+static herr_t truncate_rows(hid_t dset, hsize_t rows)
+{
+    hid_t space = H5Dget_space(dset);
+    hsize_t dims[2] = {0, 0};
+    int rank = space < 0 ? -1 : H5Sget_simple_extent_dims(space, dims, NULL);
+    CLOSE_IDS(rank, space);
+    if (rank < 1 || dims[0] < rows)
+        return -1;
+    dims[0] = rows;
+    return H5Dset_extent(dset, dims);
+}
+
+int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config_out,
+                        bk_checkpoint *checkpoint, bk_error *err)
+{
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    *out = NULL;
+    *config_out = NULL;
+    size_t len = strlen(path);
+    int is_part = len > 5 && strcmp(path + len - 5, ".part") == 0;
+    bk_h5_writer *w = calloc(1, sizeof *w);
+    if (!w)
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    w->file = w->trans_dset = w->trans_mem = H5I_INVALID_HID;
+    for (int i = 0; i < N_SERIES; ++i)
+        w->s[i].dset = H5I_INVALID_HID;
+    w->path = is_part ? strndup(path, len - 5) : strdup(path);
+    w->part = malloc(len + sizeof ".part");
+    if (!w->path || !w->part) {
+        free_writer(w);
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    }
+    sprintf(w->part, "%s.part", w->path);
+    struct stat st;
+    if (stat(w->part, &st) != 0) {
+        int complete = 0;
+        hid_t done = stat(w->path, &st) == 0 ? H5Fopen(w->path, H5F_ACC_RDONLY, H5P_DEFAULT) : H5I_INVALID_HID;
+        if (done >= 0)
+            read_numeric_attr(done, "complete", H5T_NATIVE_INT, &complete);
+        CLOSE_IDS(0, done);
+        int rc = BK_FAIL(err, BK_ERR_INVALID, "%s: %s", w->part,
+                         complete ? "no such file; the run is complete, nothing to restart"
+                                  : "no such file to restart from");
+        free_writer(w);
+        return rc;
+    }
+    bk_config *config = NULL;
+    bk_checkpoint *cp = checkpoint;
+    memset(cp, 0, sizeof *cp);
+    hsize_t rows = 0, transition_rows = 0;
+    w->file = H5Fopen(w->part, H5F_ACC_RDWR, H5P_DEFAULT);
+    int rc = w->file < 0 ? H5_FAIL(err, "%s: cannot open for the restart", w->part) : BK_OK;
+    if (rc == BK_OK) {
+        char *text = read_string_attr(w->file, "config_file");
+        char *name = read_string_attr(w->file, "config_name");
+        char *overrides = read_string_attr(w->file, "overrides");
+        const char *list[256];
+        size_t n_over = 0;
+        for (char *line = overrides ? strtok(overrides, "\n") : NULL; line && n_over < 256; line = strtok(NULL, "\n"))
+            list[n_over++] = line;
+        if (!text || !name)
+            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: no stored config to restart with", w->part);
+        else
+            rc = bk_config_load_string(text, name, list, n_over, &config, err);
+        free(text);
+        free(name);
+        free(overrides);
+    }
+    if (rc == BK_OK)
+        rc = read_checkpoint(w->file, w->part, config, cp, &rows, &transition_rows, err);
+    if (rc == BK_OK) {
+        const bk_model *model = config->model;
+        size_t n_state = model->n_friction_state;
+        size_t widest = model->n_blocks > n_state ? model->n_blocks : n_state;
+        size_t buffer_rows = CHUNK_BYTES / (widest * sizeof(double));
+        w->buffer_rows = buffer_rows < 1 ? 1 : buffer_rows > MAX_BUFFER_ROWS ? MAX_BUFFER_ROWS : buffer_rows;
+        w->n_blocks = model->n_blocks;
+        for (int i = 0; rc == BK_OK && i < N_SERIES; ++i) {
+            series *ser = &w->s[i];
+            if (H5Lexists(w->file, SERIES[i].name, H5P_DEFAULT) <= 0)
+                continue;
+            ser->dset = H5Dopen2(w->file, SERIES[i].name, H5P_DEFAULT);
+            ser->rank = SERIES[i].shape == SHAPE_T ? 1 : 2;
+            ser->cols = SERIES[i].shape == SHAPE_T ? 1 : SERIES[i].shape == SHAPE_TN ? model->n_blocks : n_state;
+            ser->elem = kind_size(SERIES[i].kind);
+            ser->buf = malloc(w->buffer_rows * ser->cols * ser->elem);
+            if (ser->dset < 0 || !ser->buf || truncate_rows(ser->dset, rows) < 0)
+                rc = H5_FAIL(err, "%s: cannot reopen /%s at the checkpoint's %llu rows", w->part,
+                             SERIES[i].name, (unsigned long long)rows);
+        }
+        if (rc == BK_OK && H5Lexists(w->file, "transitions", H5P_DEFAULT) > 0) {
+            w->trans_buf = malloc(TRANSITION_BUFFER * sizeof *w->trans_buf);
+            w->trans_mem = transition_type(0);
+            w->trans_dset = H5Dopen2(w->file, "transitions", H5P_DEFAULT);
+            if (!w->trans_buf || w->trans_mem < 0 || w->trans_dset < 0 ||
+                truncate_rows(w->trans_dset, transition_rows) < 0)
+                rc = H5_FAIL(err, "%s: cannot reopen /transitions at the checkpoint", w->part);
+        }
+        w->rows_written = rows;
+        w->trans_written = transition_rows;
+        w->t_written = w->t_buffered = cp->t_last_row;
+        if (rc == BK_OK && (write_int_attr(w->file, "complete", 0) < 0 ||
+                            write_double_attr(w->file, "t_reached", w->t_written) < 0 ||
+                            (H5Aexists(w->file, "error") > 0 && H5Adelete(w->file, "error") < 0)))
+            rc = H5_FAIL(err, "%s: cannot reset the root attributes for the restart", w->part);
+    }
+    if (rc != BK_OK) {
+        close_writer(w);
+        free_writer(w);
+        bk_checkpoint_free(cp);
+        bk_config_free(config);
+        return rc;
+    }
+    *out = w;
+    *config_out = config;
+    return BK_OK;
+}
+
 bk_sink bk_h5_writer_sink(bk_h5_writer *writer)
 {
-    bk_sink sink = {writer, sink_sample, sink_transition};
+    bk_sink sink = {writer, sink_sample, sink_transition, sink_checkpoint};
     return sink;
 }
 
