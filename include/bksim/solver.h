@@ -68,5 +68,7 @@ const bk_solver_backend *const *bk_solver_backends(void);
 
 extern const bk_solver_backend bk_solver_cvode_adams;
 extern const bk_solver_backend bk_solver_cvode_bdf;
+/* Exact piecewise-analytic (modal) stepper: affine problems only (Coulomb friction). */
+extern const bk_solver_backend bk_solver_exact;
 
 #endif

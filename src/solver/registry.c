@@ -6,6 +6,7 @@
 static const bk_solver_backend *const registered_backends[] = {
     &bk_solver_cvode_adams,
     &bk_solver_cvode_bdf,
+    &bk_solver_exact,
     NULL,
 };
 

@@ -1,0 +1,781 @@
+/* Exact piecewise-analytic stepper for affine problems (Coulomb friction, linear or frozen
+ * tension-only springs, a constant-velocity driver).
+ *
+ * What it computes.  Between two (re)starts the problem handed over is
+ *
+ *     xi'' = -K xi + a(t)          p pairs (xi, v = xi'), K = M^-1 (stiffness), constant
+ *     q'   = P xi + Q v + r(t)     quadratures (energy increments)
+ *
+ * with a and r affine in t.  start() probes the right-hand side to read K, P, Q and the
+ * affine forcing (measured from the starting state, so that u = xi - xi0 starts at 0),
+ * symmetrises S = M^(1/2) K M^(-1/2), and diagonalises S = U diag(w_k^2) U^T (GSL).  In the
+ * modal coordinates eta = U^T M^(1/2) u each mode is an undamped oscillator with a ramp
+ * force, tau = t - t0:
+ *
+ *     eta_k'' = -w_k^2 eta_k + g_k + d_k tau,   eta_k(0) = 0,  eta_k'(0) = c_k
+ *     eta_k   = c_k phi1 + g_k phi2 + d_k phi3,  eta_k' - c_k = -w_k^2 c_k phi2 + g_k phi1 + d_k phi2
+ *
+ * where phi0 = cos(w tau), phi1 = sin(w tau)/w, and phi_{j+1} is the integral of phi_j from 0,
+ * so phi2 = (1 - cos)/w^2 = 2 sin^2(w tau / 2)/w^2, phi3 = (tau - phi1)/w^2,
+ * phi4 = (tau^2/2 - phi2)/w^2; for w tau < 2 phi3 and phi4 come from their power series,
+ * and w = 0 (or w^2 within rounding of zero relative to the largest) gives tau^j / j!.  The
+ * quadratures are the integrals of their affine rates along this solution, again sums of
+ * phi2..phi4, in closed form.  Every evaluation of y(t) is exact up to rounding and costs
+ * O(p^2 + p m); nothing is integrated, so there is no truncation error at all.
+ *
+ * Root functions are sampled along the exact solution at most every 1/16 of the shortest
+ * modal period (and max_step); a sign change is located by GSL's Brent on the exact solution
+ * to the last few representable doubles and reported with the state just after the crossing,
+ * as CVODE does.  A function exactly zero at the start stays inactive until it moves away
+ * from zero (CVODE's convention).
+ *
+ * Why.  It is the accuracy yardstick for the integrators (transition times to ~1e-15
+ * relative, including case C's grazing stops that no tolerance-driven integrator resolves)
+ * and, with a few dozen root evaluations per slip, the fastest method for Coulomb scenes. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_eigen.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_matrix.h>
+#include <gsl/gsl_roots.h>
+#include <gsl/gsl_vector.h>
+
+#include "bksim/solver.h"
+
+#define PI 3.14159265358979323846
+#define SAMPLES_PER_PERIOD 16.0
+/* An eigenvalue of S below this fraction of the largest is rounding: the mode is free. */
+#define ZERO_MODE (128.0 * DBL_EPSILON)
+/* Relative size of a structural entry that must vanish (velocity dependence etc.). */
+#define STRUCTURE_TOL 1e-9
+#define BRENT_MAX_ITER 200
+#define USE_CVODE "; use cvode_adams or cvode_bdf"
+
+typedef struct exact_backend {
+    bk_solver_options options;
+    bk_ode_problem problem;
+    size_t n, p, m, n_roots;    /* state size, pairs, quadratures, root functions */
+    double t0, t_stop, h;       /* start, stop, sampling step */
+    double t_now;               /* time reached by the last step */
+    double t_lo, t_hi;          /* the last step */
+
+    /* One arena for everything sized by p, m and n; regrown only when it must. */
+    double *arena;
+    size_t arena_cap;
+    double *y0;                 /* n: the starting state */
+    double *f0, *scratch, *probe, *scale; /* n each: rates at the start, work space */
+    double *sqrt_mass;          /* p */
+    double *S, *U, *T;          /* p*p: S, its eigenvectors, T = M^(-1/2) U */
+    double *omega2, *omega;     /* p */
+    double *c, *g, *d;          /* p: modal initial velocity, forcing, forcing rate */
+    double *eta, *deta, *ieta, *idv; /* p: eta, eta' - c, their integrals */
+    double *accel0, *accel_rate;/* p: accelerations at t0 and their time rate */
+    double *P, *Q;              /* m*p: quadrature rates' position and velocity coefficients,
+                                   then (in place) the same in modal coordinates */
+    double *qdot0, *q_rate;     /* m: quadrature rates at t0 and their time rate */
+    gsl_eigen_symmv_workspace *eigen;
+
+    /* Root functions. */
+    size_t roots_cap;
+    int *direction;
+    signed char *sign;          /* last non-zero sign seen; 0 = inactive (zero so far) */
+    int *found;
+    double *g_hi, *g_try, *root_t;
+    gsl_root_fsolver *brent;
+
+    bk_solver_counters counters;
+} exact_backend;
+
+/* --- the modal basis functions ---------------------------------------------------------- */
+
+/* phi[0..4] at tau for angular frequency w >= 0 (see the header). */
+static void basis(double w, double tau, double phi[5])
+{
+    double x = w * tau;
+    double tau2 = tau * tau;
+    if (w == 0.0) {
+        phi[0] = 1.0;
+        phi[1] = tau;
+        phi[2] = 0.5 * tau2;
+        phi[3] = tau2 * tau / 6.0;
+        phi[4] = tau2 * tau2 / 24.0;
+        return;
+    }
+    double w2 = w * w, half = sin(0.5 * x);
+    phi[0] = cos(x);
+    phi[1] = sin(x) / w;
+    phi[2] = 2.0 * half * half / w2;
+    if (fabs(x) >= 2.0) {
+        phi[3] = (tau - phi[1]) / w2;
+        phi[4] = (0.5 * tau2 - phi[2]) / w2;
+        return;
+    }
+    /* sum_m (-x^2)^m / (j + 2m)!, j = 3, 4: alternating, terms below 1/j! from the start. */
+    double z = x * x;
+    for (int j = 3; j <= 4; ++j) {
+        double term = j == 3 ? 1.0 / 6.0 : 1.0 / 24.0, sum = term;
+        for (int k = 0; k < 40 && fabs(term) > 1e-18 * fabs(sum); ++k) {
+            term *= -z / (double)((j + 2 * k + 1) * (j + 2 * k + 2));
+            sum += term;
+        }
+        phi[j] = (j == 3 ? tau2 * tau : tau2 * tau2) * sum;
+    }
+}
+
+/* The exact state at time t into y (size n). */
+static void exact_state(exact_backend *eb, double t, double *y)
+{
+    size_t p = eb->p, m = eb->m;
+    double tau = t - eb->t0;
+    for (size_t k = 0; k < p; ++k) {
+        double phi[5], w2 = eb->omega2[k];
+        basis(eb->omega[k], tau, phi);
+        double ck = eb->c[k], gk = eb->g[k], dk = eb->d[k];
+        eb->eta[k] = ck * phi[1] + gk * phi[2] + dk * phi[3];
+        eb->deta[k] = -w2 * ck * phi[2] + gk * phi[1] + dk * phi[2];
+        eb->ieta[k] = ck * phi[2] + gk * phi[3] + dk * phi[4];
+        eb->idv[k] = (dk - w2 * ck) * phi[3] + gk * phi[2];
+    }
+    for (size_t i = 0; i < p; ++i) {
+        const double *Ti = &eb->T[i * p];
+        double u = 0.0, dv = 0.0;
+        for (size_t k = 0; k < p; ++k) {
+            u += Ti[k] * eb->eta[k];
+            dv += Ti[k] * eb->deta[k];
+        }
+        y[2 * i] = eb->y0[2 * i] + u;
+        y[2 * i + 1] = eb->y0[2 * i + 1] + dv;
+    }
+    for (size_t j = 0; j < m; ++j) {
+        const double *Pj = &eb->P[j * p], *Qj = &eb->Q[j * p];
+        double sum = 0.0;
+        for (size_t k = 0; k < p; ++k)
+            sum += Pj[k] * eb->ieta[k] + Qj[k] * eb->idv[k];
+        y[2 * p + j] = eb->y0[2 * p + j] + (eb->qdot0[j] + 0.5 * eb->q_rate[j] * tau) * tau + sum;
+    }
+}
+
+/* --- memory ----------------------------------------------------------------------------- */
+
+static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roots, bk_error *err)
+{
+    size_t need = 5 * n + 3 * p * p + 12 * p + 2 * m * p + 2 * m + 1;
+    if (need > eb->arena_cap) {
+        double *grown = malloc(need * sizeof *grown);
+        if (!grown)
+            return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu components", n);
+        free(eb->arena);
+        eb->arena = grown;
+        eb->arena_cap = need;
+    }
+    double *a = eb->arena;
+    eb->y0 = a, a += n;
+    eb->f0 = a, a += n;
+    eb->scratch = a, a += n;
+    eb->probe = a, a += n;
+    eb->scale = a, a += n;
+    eb->S = a, a += p * p;
+    eb->U = a, a += p * p;
+    eb->T = a, a += p * p;
+    eb->sqrt_mass = a, a += p;
+    eb->omega2 = a, a += p;
+    eb->omega = a, a += p;
+    eb->c = a, a += p;
+    eb->g = a, a += p;
+    eb->d = a, a += p;
+    eb->eta = a, a += p;
+    eb->deta = a, a += p;
+    eb->ieta = a, a += p;
+    eb->idv = a, a += p;
+    eb->accel0 = a, a += p;
+    eb->accel_rate = a, a += p;
+    eb->P = a, a += m * p;
+    eb->Q = a, a += m * p;
+    eb->qdot0 = a, a += m;
+    eb->q_rate = a;
+
+    /* GSL documents the workspace for one matrix size: keep it exactly p. */
+    if (p > 1 && (!eb->eigen || eb->eigen->size != p)) {
+        if (eb->eigen)
+            gsl_eigen_symmv_free(eb->eigen);
+        eb->eigen = gsl_eigen_symmv_alloc(p);
+        if (!eb->eigen)
+            return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu modes", p);
+    }
+
+    if (n_roots > eb->roots_cap) {
+        free(eb->direction);
+        free(eb->sign);
+        free(eb->found);
+        free(eb->g_hi);
+        eb->direction = malloc(n_roots * sizeof *eb->direction);
+        eb->sign = malloc(n_roots * sizeof *eb->sign);
+        eb->found = malloc(n_roots * sizeof *eb->found);
+        eb->g_hi = malloc(3 * n_roots * sizeof *eb->g_hi);
+        eb->roots_cap = 0;
+        if (!eb->direction || !eb->sign || !eb->found || !eb->g_hi)
+            return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu root functions",
+                           n_roots);
+        eb->roots_cap = n_roots;
+    }
+    if (eb->g_hi) {
+        eb->g_try = eb->g_hi + eb->roots_cap;
+        eb->root_t = eb->g_try + eb->roots_cap;
+    }
+    return BK_OK;
+}
+
+static int create(void **mem, const bk_solver_options *options, bk_error *err)
+{
+    exact_backend *eb = calloc(1, sizeof *eb);
+    if (!eb)
+        return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory");
+    eb->options = *options;
+    eb->brent = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
+    if (!eb->brent) {
+        free(eb);
+        return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for the root finder");
+    }
+    *mem = eb;
+    return BK_OK;
+}
+
+static void destroy(void *mem)
+{
+    exact_backend *eb = mem;
+    if (!eb)
+        return;
+    if (eb->eigen)
+        gsl_eigen_symmv_free(eb->eigen);
+    gsl_root_fsolver_free(eb->brent);
+    free(eb->arena);
+    free(eb->direction);
+    free(eb->sign);
+    free(eb->found);
+    free(eb->g_hi);
+    free(eb);
+}
+
+/* --- start: probe, diagonalise ---------------------------------------------------------- */
+
+static int call_rhs(exact_backend *eb, double t, const double *y, double *ydot, bk_error *err)
+{
+    eb->counters.rhs_evals++;
+    int rc = eb->problem.rhs(t, y, ydot, eb->problem.user);
+    if (rc != 0)
+        return BK_FAIL(err, BK_ERR_SOLVER,
+                       "exact stepper: the right-hand side failed (code %d) at t = %.17g s", rc, t);
+    for (size_t k = 0; k < eb->n; ++k)
+        if (!isfinite(ydot[k]))
+            return BK_FAIL(err, BK_ERR_NUMERIC,
+                           "exact stepper: non-finite right-hand side (component %zu) at t = %.17g s",
+                           k, t);
+    return BK_OK;
+}
+
+static int call_roots(exact_backend *eb, double t, double *g, bk_error *err)
+{
+    if (eb->n_roots == 0)
+        return BK_OK;
+    exact_state(eb, t, eb->scratch);
+    eb->counters.root_evals++;
+    int rc = eb->problem.roots(t, eb->scratch, g, eb->problem.user);
+    if (rc != 0)
+        return BK_FAIL(err, BK_ERR_SOLVER,
+                       "exact stepper: the root functions failed (code %d) at t = %.17g s", rc, t);
+    for (size_t i = 0; i < eb->n_roots; ++i)
+        if (isnan(g[i]))
+            return BK_FAIL(err, BK_ERR_NUMERIC,
+                           "exact stepper: root function %zu is NaN at t = %.17g s", i, t);
+    return BK_OK;
+}
+
+/* A position's rate must be its velocity. */
+static int check_kinematics(const exact_backend *eb, const double *y, const double *ydot, bk_error *err)
+{
+    for (size_t i = 0; i < eb->p; ++i) {
+        double v = y[2 * i + 1];
+        if (fabs(ydot[2 * i] - v) > 8.0 * DBL_EPSILON * fabs(v))
+            return BK_FAIL(err, BK_ERR_CONFIG,
+                           "method exact: the rate of position %zu is not its velocity; the state "
+                           "must be (position, velocity) pairs followed by quadratures" USE_CVODE,
+                           i);
+    }
+    return BK_OK;
+}
+
+/* A perturbation of component `k` of y0 that is exactly representable as a difference. */
+static double perturb(exact_backend *eb, size_t k)
+{
+    memcpy(eb->scratch, eb->y0, eb->n * sizeof *eb->scratch);
+    double bumped = eb->y0[k] + (1.0 + fabs(eb->y0[k]));
+    eb->scratch[k] = bumped;
+    return bumped - eb->y0[k];
+}
+
+/* Read K, the forcing and the quadrature rates off the right-hand side. */
+static int probe(exact_backend *eb, bk_error *err)
+{
+    const double *f0 = eb->f0;
+    size_t n = eb->n, p = eb->p, m = eb->m;
+    double t0 = eb->t0;
+    double *f = eb->probe, *scale = eb->scale;
+    int rc;
+    if ((rc = check_kinematics(eb, eb->y0, f0, err)) != BK_OK)
+        return rc;
+    for (size_t k = 0; k < n; ++k)
+        scale[k] = fabs(f0[k]);
+    for (size_t i = 0; i < p; ++i)
+        eb->accel0[i] = f0[2 * i + 1];
+    for (size_t j = 0; j < m; ++j)
+        eb->qdot0[j] = f0[2 * p + j];
+
+    /* Positions: columns of -K (into S, unscaled for now) and of P. */
+    for (size_t l = 0; l < p; ++l) {
+        double h = perturb(eb, 2 * l);
+        if ((rc = call_rhs(eb, t0, eb->scratch, f, err)) != BK_OK ||
+            (rc = check_kinematics(eb, eb->scratch, f, err)) != BK_OK)
+            return rc;
+        for (size_t i = 0; i < p; ++i) {
+            double delta = f[2 * i + 1] - f0[2 * i + 1];
+            eb->S[i * p + l] = -delta / h;
+            scale[2 * i + 1] += fabs(delta);
+        }
+        for (size_t j = 0; j < m; ++j) {
+            double delta = f[2 * p + j] - f0[2 * p + j];
+            eb->P[j * p + l] = delta / h;
+            scale[2 * p + j] += fabs(delta);
+        }
+    }
+    /* Time: the forcing's rate. */
+    double dt = (t0 + (1.0 + fabs(t0))) - t0;
+    memcpy(eb->scratch, eb->y0, n * sizeof *eb->scratch);
+    if ((rc = call_rhs(eb, t0 + dt, eb->scratch, f, err)) != BK_OK ||
+        (rc = check_kinematics(eb, eb->scratch, f, err)) != BK_OK)
+        return rc;
+    for (size_t i = 0; i < p; ++i) {
+        double delta = f[2 * i + 1] - f0[2 * i + 1];
+        eb->accel_rate[i] = delta / dt;
+        scale[2 * i + 1] += fabs(delta);
+    }
+    for (size_t j = 0; j < m; ++j) {
+        double delta = f[2 * p + j] - f0[2 * p + j];
+        eb->q_rate[j] = delta / dt;
+        scale[2 * p + j] += fabs(delta);
+    }
+    /* Velocities: accelerations must not depend on them; columns of Q. */
+    for (size_t l = 0; l < p; ++l) {
+        double h = perturb(eb, 2 * l + 1);
+        if ((rc = call_rhs(eb, t0, eb->scratch, f, err)) != BK_OK ||
+            (rc = check_kinematics(eb, eb->scratch, f, err)) != BK_OK)
+            return rc;
+        for (size_t i = 0; i < p; ++i) {
+            double delta = f[2 * i + 1] - f0[2 * i + 1];
+            if (fabs(delta) > STRUCTURE_TOL * scale[2 * i + 1])
+                return BK_FAIL(err, BK_ERR_CONFIG,
+                               "method exact: the acceleration of pair %zu depends on the velocity "
+                               "of pair %zu (velocity-dependent friction or damping); it needs "
+                               "Coulomb friction (constant sliding force, no friction state)" USE_CVODE,
+                               i, l);
+        }
+        for (size_t j = 0; j < m; ++j) {
+            double delta = f[2 * p + j] - f0[2 * p + j];
+            eb->Q[j * p + l] = delta / h;
+            scale[2 * p + j] += fabs(delta);
+        }
+    }
+    /* Quadratures: nothing may depend on them. */
+    for (size_t j = 0; j < m; ++j) {
+        perturb(eb, 2 * p + j);
+        if ((rc = call_rhs(eb, t0, eb->scratch, f, err)) != BK_OK ||
+            (rc = check_kinematics(eb, eb->scratch, f, err)) != BK_OK)
+            return rc;
+        for (size_t k = 0; k < n; ++k)
+            if ((k % 2 == 1 || k >= 2 * p) && fabs(f[k] - f0[k]) > STRUCTURE_TOL * scale[k])
+                return BK_FAIL(err, BK_ERR_CONFIG,
+                               "method exact: component %zu's rate depends on component %zu, "
+                               "which should be a quadrature" USE_CVODE,
+                               k, 2 * p + j);
+    }
+    return BK_OK;
+}
+
+/* Symmetrise and diagonalise; fill the modal data and the sampling step. */
+static int modes(exact_backend *eb, bk_error *err)
+{
+    size_t p = eb->p, m = eb->m;
+    double s_max = 0.0;
+    for (size_t i = 0; i < p; ++i) {
+        double mass = eb->problem.pair_mass[i];
+        if (!(mass > 0.0) || !isfinite(mass))
+            return BK_FAIL(err, BK_ERR_INVALID, "exact stepper: pair %zu has mass %g", i, mass);
+        eb->sqrt_mass[i] = sqrt(mass);
+    }
+    for (size_t i = 0; i < p; ++i)
+        for (size_t l = 0; l < p; ++l) {
+            eb->S[i * p + l] *= eb->sqrt_mass[i] / eb->sqrt_mass[l];
+            s_max = fmax(s_max, fabs(eb->S[i * p + l]));
+        }
+    for (size_t i = 0; i < p; ++i)
+        for (size_t l = i + 1; l < p; ++l) {
+            double a = eb->S[i * p + l], b = eb->S[l * p + i];
+            if (fabs(a - b) > STRUCTURE_TOL * s_max)
+                return BK_FAIL(err, BK_ERR_CONFIG,
+                               "method exact: the stiffness coupling pairs %zu and %zu is not "
+                               "symmetric with the pair masses (%.6g vs %.6g)" USE_CVODE,
+                               i, l, a, b);
+            eb->S[i * p + l] = eb->S[l * p + i] = 0.5 * (a + b);
+        }
+    if (p == 1) {
+        eb->omega2[0] = eb->S[0];
+        eb->U[0] = 1.0;
+    } else if (p > 1) {
+        gsl_matrix_view A = gsl_matrix_view_array(eb->S, p, p);
+        gsl_matrix_view V = gsl_matrix_view_array(eb->U, p, p);
+        gsl_vector_view lambda = gsl_vector_view_array(eb->omega2, p);
+        int rc = gsl_eigen_symmv(&A.matrix, &lambda.vector, &V.matrix, eb->eigen);
+        if (rc != GSL_SUCCESS)
+            return BK_FAIL(err, BK_ERR_SOLVER, "exact stepper: eigen-decomposition failed: %s",
+                           gsl_strerror(rc));
+    }
+    double lambda_max = 0.0;
+    for (size_t k = 0; k < p; ++k)
+        lambda_max = fmax(lambda_max, fabs(eb->omega2[k]));
+    for (size_t k = 0; k < p; ++k) {
+        double l = eb->omega2[k];
+        if (l < -ZERO_MODE * lambda_max)
+            return BK_FAIL(err, BK_ERR_CONFIG,
+                           "method exact: mode %zu is unstable (negative stiffness eigenvalue %.6g "
+                           "s^-2); only oscillating or free modes are solved exactly" USE_CVODE,
+                           k, l);
+        if (l <= ZERO_MODE * lambda_max)
+            l = 0.0;
+        eb->omega2[k] = l;
+        eb->omega[k] = sqrt(l);
+    }
+    /* Modal initial velocity, forcing and forcing rate; T = M^(-1/2) U. */
+    for (size_t k = 0; k < p; ++k) {
+        double c = 0.0, g = 0.0, d = 0.0;
+        for (size_t i = 0; i < p; ++i) {
+            double u = eb->U[i * p + k] * eb->sqrt_mass[i];
+            c += u * eb->y0[2 * i + 1];
+            g += u * eb->accel0[i];
+            d += u * eb->accel_rate[i];
+        }
+        eb->c[k] = c;
+        eb->g[k] = g;
+        eb->d[k] = d;
+    }
+    for (size_t i = 0; i < p; ++i)
+        for (size_t k = 0; k < p; ++k)
+            eb->T[i * p + k] = eb->U[i * p + k] / eb->sqrt_mass[i];
+    /* Quadrature coefficients into modal coordinates, in place (a row at a time). */
+    for (size_t j = 0; j < m; ++j) {
+        double *Pj = &eb->P[j * p], *Qj = &eb->Q[j * p];
+        for (size_t k = 0; k < p; ++k) {
+            double pk = 0.0, qk = 0.0;
+            for (size_t l = 0; l < p; ++l) {
+                pk += Pj[l] * eb->T[l * p + k];
+                qk += Qj[l] * eb->T[l * p + k];
+            }
+            eb->eta[k] = pk;
+            eb->deta[k] = qk;
+        }
+        memcpy(Pj, eb->eta, p * sizeof *Pj);
+        memcpy(Qj, eb->deta, p * sizeof *Qj);
+    }
+    /* Sampling step: a sixteenth of the shortest period, max_step, else a sixteenth of the
+     * span (polynomial motion only). */
+    double h = lambda_max > 0.0 ? 2.0 * PI / (SAMPLES_PER_PERIOD * sqrt(lambda_max)) : INFINITY;
+    double max_step = eb->options.max_step;
+    if (isfinite(max_step) && max_step > 0.0 && max_step < h)
+        h = max_step;
+    if (!isfinite(h)) {
+        double span = eb->t_stop - eb->t0;
+        h = isfinite(span) && span > 0.0 ? span / SAMPLES_PER_PERIOD : 1.0 + fabs(eb->t0);
+    }
+    eb->h = h;
+    return BK_OK;
+}
+
+static int start(void *mem, const bk_ode_problem *problem, double t0, const double *y0,
+                 const double *atol, size_t n, double t_stop, bk_error *err)
+{
+    (void)atol; /* exact: no tolerance to meet */
+    exact_backend *eb = mem;
+    eb->problem = *problem;
+    if (!problem->affine)
+        return BK_FAIL(err, BK_ERR_CONFIG,
+                       "method exact needs Coulomb friction (constant sliding force, no friction "
+                       "state)" USE_CVODE);
+    size_t p = problem->n_pairs;
+    if (2 * p > n || (p > 0 && !problem->pair_mass))
+        return BK_FAIL(err, BK_ERR_CONFIG,
+                       "method exact needs the state as (position, velocity) pairs followed only "
+                       "by quadratures (n = %zu, n_pairs = %zu)" USE_CVODE,
+                       n, p);
+    if (!isfinite(t0) || !(t_stop >= t0))
+        return BK_FAIL(err, BK_ERR_INVALID, "exact stepper: bad interval [%.17g, %.17g] s", t0, t_stop);
+    int rc = reserve(eb, n, p, n - 2 * p, problem->n_roots, err);
+    if (rc != BK_OK)
+        return rc;
+    eb->n = n;
+    eb->p = p;
+    eb->m = n - 2 * p;
+    eb->n_roots = problem->n_roots;
+    eb->t0 = eb->t_now = eb->t_lo = eb->t_hi = t0;
+    eb->t_stop = t_stop;
+    memcpy(eb->y0, y0, n * sizeof *y0);
+
+    if ((rc = call_rhs(eb, t0, eb->y0, eb->f0, err)) != BK_OK || (rc = probe(eb, err)) != BK_OK ||
+        (rc = modes(eb, err)) != BK_OK)
+        return rc;
+
+    if (eb->n_roots > 0) {
+        memcpy(eb->direction, problem->root_direction, eb->n_roots * sizeof *eb->direction);
+        if ((rc = call_roots(eb, t0, eb->g_hi, err)) != BK_OK)
+            return rc;
+        for (size_t i = 0; i < eb->n_roots; ++i)
+            eb->sign[i] = (signed char)(eb->g_hi[i] > 0.0 ? 1 : eb->g_hi[i] < 0.0 ? -1 : 0);
+    }
+    return BK_OK;
+}
+
+/* --- step: sample, bracket, locate ------------------------------------------------------ */
+
+/* Has function i crossed, in a direction it listens to, from its last sign to value g? */
+static int crossed(const exact_backend *eb, size_t i, double g)
+{
+    int s = eb->sign[i];
+    if (s == 0 || g * s > 0.0)
+        return 0;
+    return eb->direction[i] == 0 || eb->direction[i] == -s;
+}
+
+typedef struct root_probe {
+    exact_backend *eb;
+    size_t index;
+    bk_error *err;
+    int status;
+} root_probe;
+
+static double root_value(double t, void *user)
+{
+    root_probe *rp = user;
+    if (rp->status != BK_OK)
+        return NAN;
+    rp->status = call_roots(rp->eb, t, rp->eb->g_try, rp->err);
+    return rp->status == BK_OK ? rp->eb->g_try[rp->index] : NAN;
+}
+
+/* Locate the crossing of function i in [lo, hi] (its old sign at or before lo, its new sign
+ * or zero at hi, value g_hi): *t_root is the earliest time found where it holds its new
+ * sign or zero, within a few doubles of the zero. */
+static int locate(exact_backend *eb, size_t i, double lo, double hi, double g_hi, double *t_root,
+                  bk_error *err)
+{
+    root_probe rp = {eb, i, err, BK_OK};
+    gsl_function fn = {root_value, &rp};
+    int old = eb->sign[i];
+    if (g_hi == 0.0 || hi <= lo) {
+        *t_root = hi;
+        return BK_OK;
+    }
+    /* lo's value differs from the last sign seen only when it is exactly zero there: the
+     * crossing is at lo. */
+    double g_lo = root_value(lo, &rp);
+    if (rp.status != BK_OK)
+        return rp.status;
+    if (g_lo * old <= 0.0) {
+        *t_root = lo;
+        return BK_OK;
+    }
+    for (int attempt = 0; attempt < 64; ++attempt) {
+        if (g_hi == 0.0 || hi <= lo) {
+            *t_root = hi;
+            return BK_OK;
+        }
+        int rc = gsl_root_fsolver_set(eb->brent, &fn, lo, hi);
+        if (rp.status != BK_OK)
+            return rp.status;
+        if (rc != GSL_SUCCESS)
+            return BK_FAIL(err, BK_ERR_SOLVER,
+                           "exact stepper: cannot bracket root function %zu in [%.17g, %.17g] s: %s",
+                           i, lo, hi, gsl_strerror(rc));
+        double a = lo, b = hi;
+        for (int iter = 0; iter < BRENT_MAX_ITER; ++iter) {
+            rc = gsl_root_fsolver_iterate(eb->brent);
+            if (rp.status != BK_OK)
+                return rp.status;
+            if (rc != GSL_SUCCESS)
+                return BK_FAIL(err, BK_ERR_SOLVER,
+                               "exact stepper: locating root function %zu failed: %s", i,
+                               gsl_strerror(rc));
+            a = gsl_root_fsolver_x_lower(eb->brent);
+            b = gsl_root_fsolver_x_upper(eb->brent);
+            if (b - a <= 2.0 * DBL_EPSILON * fmax(fabs(a), fabs(b)))
+                break;
+        }
+        double g_b = root_value(b, &rp);
+        if (rp.status != BK_OK)
+            return rp.status;
+        if (g_b * old <= 0.0) {
+            *t_root = b;
+            return BK_OK;
+        }
+        /* Brent closed on a later crossing back: an earlier one lies in [lo, a]. */
+        hi = a;
+        g_hi = root_value(a, &rp);
+        if (rp.status != BK_OK)
+            return rp.status;
+    }
+    return BK_FAIL(err, BK_ERR_SOLVER, "exact stepper: root function %zu oscillates too fast to locate "
+                   "near t = %.17g s", i, lo);
+}
+
+static void update_signs(exact_backend *eb, const double *g)
+{
+    for (size_t i = 0; i < eb->n_roots; ++i)
+        if (g[i] != 0.0)
+            eb->sign[i] = (signed char)(g[i] > 0.0 ? 1 : -1);
+}
+
+/* Look for crossings in (lo, hi] (values g at hi).  Returns 1 with *t_root and found[] when
+ * some function crossed, 0 when none did, < 0 on failure. */
+static int find_roots(exact_backend *eb, double lo, double hi, double *t_root, bk_error *err)
+{
+    size_t nr = eb->n_roots;
+    double *g = eb->g_hi;
+    for (int round = 0; round < 64; ++round) {
+        double first = INFINITY;
+        int any = 0;
+        for (size_t i = 0; i < nr; ++i) {
+            eb->root_t[i] = INFINITY;
+            if (!crossed(eb, i, g[i]))
+                continue;
+            int rc = locate(eb, i, lo, hi, g[i], &eb->root_t[i], err);
+            if (rc != BK_OK)
+                return rc;
+            first = fmin(first, eb->root_t[i]);
+            any = 1;
+        }
+        if (!any)
+            return 0;
+        /* Everything crossing within the root tolerance of the first is one event, reported
+         * at the latest of their located times so that each has crossed there. */
+        double tol = 100.0 * DBL_EPSILON * (fabs(first) + eb->h);
+        double t = first;
+        for (size_t i = 0; i < nr; ++i)
+            if (eb->root_t[i] <= first + tol && eb->root_t[i] > t)
+                t = eb->root_t[i];
+        int rc = call_roots(eb, t, eb->g_try, err);
+        if (rc != BK_OK)
+            return rc;
+        /* A function found crossing later whose sign has already flipped at t crossed more
+         * than once in (lo, hi]: look again in (lo, t]. */
+        int again = 0;
+        for (size_t i = 0; i < nr; ++i)
+            if (eb->root_t[i] > first + tol && crossed(eb, i, eb->g_try[i]))
+                again = 1;
+        if (again && t < hi) {
+            hi = t;
+            memcpy(g, eb->g_try, nr * sizeof *g);
+            continue;
+        }
+        for (size_t i = 0; i < nr; ++i) {
+            int hit = eb->root_t[i] <= first + tol || crossed(eb, i, eb->g_try[i]);
+            eb->found[i] = hit ? -eb->sign[i] : 0;
+        }
+        update_signs(eb, eb->g_try);
+        for (size_t i = 0; i < nr; ++i)
+            if (eb->found[i])
+                eb->sign[i] = (signed char)eb->found[i];
+        *t_root = t;
+        return 1;
+    }
+    return BK_FAIL(err, BK_ERR_SOLVER, "exact stepper: cannot separate the roots near t = %.17g s", lo);
+}
+
+static int step(void *mem, double *t_reached, double *y, bk_error *err)
+{
+    exact_backend *eb = mem;
+    double lo = eb->t_now;
+    if (lo >= eb->t_stop) {
+        eb->t_lo = eb->t_hi = eb->t_stop;
+        exact_state(eb, eb->t_stop, y);
+        *t_reached = eb->t_stop;
+        return BK_STEP_STOP;
+    }
+    double hi = lo + eb->h;
+    /* Never leave a sliver before the stop time. */
+    if (!(hi < eb->t_stop - 1e-3 * eb->h))
+        hi = eb->t_stop;
+    eb->counters.steps++;
+    int rc = call_roots(eb, hi, eb->g_hi, err);
+    if (rc != BK_OK)
+        return rc;
+    double t_root = hi;
+    int status = eb->n_roots > 0 ? find_roots(eb, lo, hi, &t_root, err) : 0;
+    if (status < 0)
+        return status;
+    eb->t_lo = lo;
+    if (status == 1) {
+        eb->t_now = eb->t_hi = t_root;
+        exact_state(eb, t_root, y);
+        *t_reached = t_root;
+        return BK_STEP_ROOT;
+    }
+    update_signs(eb, eb->g_hi);
+    eb->t_now = eb->t_hi = hi;
+    exact_state(eb, hi, y);
+    *t_reached = hi;
+    return hi == eb->t_stop ? BK_STEP_STOP : BK_STEP_OK;
+}
+
+static int interpolate(void *mem, double t, double *y, bk_error *err)
+{
+    exact_backend *eb = mem;
+    if (!(t >= eb->t0 && t <= eb->t_stop))
+        return BK_FAIL(err, BK_ERR_SOLVER,
+                       "exact stepper: t = %.17g s is outside the solution [%.17g, %.17g] s", t,
+                       eb->t0, eb->t_stop);
+    exact_state(eb, t, y);
+    return BK_OK;
+}
+
+static void last_step(void *mem, double *t_lo, double *t_hi)
+{
+    exact_backend *eb = mem;
+    *t_lo = eb->t_lo;
+    *t_hi = eb->t_hi;
+}
+
+static int root_info(void *mem, int *found)
+{
+    exact_backend *eb = mem;
+    if (eb->n_roots > 0)
+        memcpy(found, eb->found, eb->n_roots * sizeof *found);
+    return BK_OK;
+}
+
+static void counters(void *mem, bk_solver_counters *c)
+{
+    exact_backend *eb = mem;
+    *c = eb->counters;
+}
+
+const bk_solver_backend bk_solver_exact = {
+    .name = "exact",
+    .doc = "exact piecewise-analytic (modal) stepper for Coulomb friction; roots to ~1e-15",
+    .create = create,
+    .start = start,
+    .step = step,
+    .interpolate = interpolate,
+    .last_step = last_step,
+    .root_info = root_info,
+    .counters = counters,
+    .destroy = destroy,
+};

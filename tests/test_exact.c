@@ -1,0 +1,754 @@
+/* The exact piecewise-analytic stepper: its modal solution against independent closed forms,
+ * the paper's single block (cases A, B, C, both springs) against tests/exact_single.c to
+ * ~1e-12 (every transition, including case C's 0.2 ms sticks that integrators cannot
+ * resolve), 10-block chains against CVODE Adams at rtol 1e-12, refusal of non-affine
+ * problems with a clear message, and its speed next to CVODE (reported, not asserted). */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bk_test.h"
+#include "bksim/bksim.h"
+#include "exact_single.h"
+
+#define PI 3.14159265358979323846
+
+/* --- a memory sink (as in test_run.c) -------------------------------------------------- */
+
+typedef struct recorder {
+    bk_transition *transitions;
+    size_t n_transitions, cap_transitions;
+    size_t rows;
+    double last_t;
+    int time_decreased;
+    double max_balance_error; /* |W - dE_el - dE_kin - D| over rows, J */
+    double max_work;          /* J */
+    double elastic0, kinetic0;
+} recorder;
+
+static int record_sample(void *self, const bk_sample *s, bk_error *err)
+{
+    (void)err;
+    recorder *r = self;
+    if (r->rows > 0 && !(s->t > r->last_t))
+        r->time_decreased = 1;
+    if (r->rows == 0) {
+        r->elastic0 = s->elastic_energy;
+        r->kinetic0 = s->kinetic_energy;
+    }
+    r->last_t = s->t;
+    r->rows++;
+    double balance = s->work_driver - (s->elastic_energy - r->elastic0) -
+                     (s->kinetic_energy - r->kinetic0) - s->dissipation;
+    r->max_balance_error = fmax(r->max_balance_error, fabs(balance));
+    r->max_work = fmax(r->max_work, fabs(s->work_driver));
+    return BK_OK;
+}
+
+static int record_transition(void *self, const bk_transition *t, bk_error *err)
+{
+    (void)err;
+    recorder *r = self;
+    if (r->n_transitions == r->cap_transitions) {
+        size_t cap = r->cap_transitions ? 2 * r->cap_transitions : 64;
+        bk_transition *grown = realloc(r->transitions, cap * sizeof *grown);
+        if (!grown)
+            return BK_ERR_NOMEM;
+        r->transitions = grown;
+        r->cap_transitions = cap;
+    }
+    r->transitions[r->n_transitions++] = *t;
+    return BK_OK;
+}
+
+static void recorder_free(recorder *r) { free(r->transitions); }
+
+/* --- scenes built in code (as in test_run.c) ------------------------------------------- */
+
+typedef struct scene_spec {
+    size_t n;
+    double mass, stiffness, coupling, mu_s, mu_d, velocity, t_end, rtol, interval;
+    bk_spring spring;
+    bk_boundary boundary;
+    const char *method;
+} scene_spec;
+
+static scene_spec paper_case(double mu_d, bk_spring spring, const char *method)
+{
+    return (scene_spec){.n = 1, .mass = 1.0, .stiffness = 1e4, .coupling = 0.0, .mu_s = 0.6,
+                        .mu_d = mu_d, .velocity = 1e-3, .t_end = 5.0, .rtol = 1e-10,
+                        .interval = 1e-3, .spring = spring, .boundary = BK_BOUNDARY_FREE,
+                        .method = method};
+}
+
+static bk_config *make_config(const scene_spec *spec)
+{
+    bk_config *c = calloc(1, sizeof *c);
+    assert_non_null(c);
+    bk_model *m = bk_model_create(spec->n);
+    assert_non_null(m);
+    m->boundary = spec->boundary;
+    m->coupling_stiffness = spec->coupling;
+    m->gravity = 9.81;
+    m->spring = spec->spring;
+    m->driver.velocity = spec->velocity;
+    for (size_t i = 0; i < spec->n; ++i) {
+        bk_block *b = &m->blocks[i];
+        b->mass = spec->mass;
+        b->driver_stiffness = spec->stiffness;
+        b->normal_force = spec->mass * 9.81;
+        b->law = &bk_friction_coulomb;
+        b->friction_params[0] = spec->mu_s;
+        b->friction_params[1] = spec->mu_d;
+    }
+    bk_model_finalize(m);
+    c->model = m;
+    c->t_end = spec->t_end;
+    snprintf(c->solver.method, sizeof c->solver.method, "%s", spec->method);
+    snprintf(c->solver.linear_solver, sizeof c->solver.linear_solver, "auto");
+    c->solver.rtol = spec->rtol;
+    c->solver.atol_x = c->solver.atol_v = c->solver.max_step = NAN;
+    c->solver.max_steps = 1000000;
+    c->solver.detect_velocity_extrema = 1;
+    c->solver.max_transitions_per_instant = 100;
+    c->solver.instant_window = NAN;
+    c->output.interval = spec->interval;
+    c->output.fields = BK_FIELD_ALL;
+    c->output.transitions = 1;
+    c->output.event_rows = 1;
+    return c;
+}
+
+static void free_config(bk_config *c)
+{
+    bk_model_free(c->model);
+    free(c);
+}
+
+static int run_config(const bk_config *c, recorder *r, bk_run_stats *stats, bk_error *err)
+{
+    bk_sink sink = {.self = r, .sample = record_sample, .transition = record_transition};
+    return bk_run(c, &sink, stats, NULL, NULL, err);
+}
+
+static double relative(double a, double b) { return fabs(a - b) / fmax(fabs(b), DBL_MIN); }
+
+/* --- the back-end alone against closed forms ------------------------------------------- */
+
+/* x'' = -w^2 x + g + d t (one pair, unit mass) with quadratures q0' = 2 x + 3 v + 1 + 0.5 t
+ * and q1' = v; w = 0 makes it polynomial. */
+typedef struct forced {
+    double w, g, d;
+} forced;
+
+static int forced_rhs(double t, const double *y, double *ydot, void *user)
+{
+    const forced *f = user;
+    ydot[0] = y[1];
+    ydot[1] = -f->w * f->w * y[0] + f->g + f->d * t;
+    ydot[2] = 2.0 * y[0] + 3.0 * y[1] + 1.0 + 0.5 * t;
+    ydot[3] = y[1];
+    return 0;
+}
+
+static int forced_roots(double t, const double *y, double *g, void *user)
+{
+    (void)t;
+    (void)user;
+    g[0] = y[0] - 0.25; /* position through 0.25 */
+    g[1] = y[1];        /* velocity through zero */
+    return 0;
+}
+
+/* Reference in long double: the Taylor series of the ODE itself (a_{n+2} from a_n) while
+ * w tau < 2, else the textbook trigonometric form (whose cancellation the extra precision
+ * covers there). */
+static void forced_exact(const forced *f, double t0, const double *y0, double t, long double *y)
+{
+    long double w = f->w, w2 = w * w, tau = (long double)t - t0;
+    long double x0 = y0[0], v0 = y0[1];
+    long double g = (long double)f->g + (long double)f->d * t0, d = f->d; /* forcing g + d tau */
+    long double x = 0, v = 0, ix = 0;
+    if (w * tau < 2.0L) {
+        long double a[64];
+        a[0] = x0;
+        a[1] = v0;
+        for (int k = 0; k + 2 < 64; ++k)
+            a[k + 2] = (-w2 * a[k] + (k == 0 ? g : k == 1 ? d : 0.0L)) / ((k + 1) * (k + 2));
+        long double power = 1.0L; /* tau^k */
+        for (int k = 0; k < 64; ++k) {
+            if (k > 0)
+                v += k * a[k] * power / tau;
+            x += a[k] * power;
+            ix += a[k] * power * tau / (k + 1);
+            power *= tau;
+        }
+    } else {
+        long double c = cosl(w * tau), s = sinl(w * tau);
+        long double A = x0 - g / w2, B = (v0 - d / w2) / w; /* about the particular (g + d tau)/w^2 */
+        x = g / w2 + d * tau / w2 + A * c + B * s;
+        v = d / w2 - A * w * s + B * w * c;
+        ix = g * tau / w2 + d * tau * tau / (2 * w2) + A * s / w + B * (1 - c) / w;
+    }
+    y[0] = x;
+    y[1] = v;
+    y[2] = y0[2] + 2 * ix + 3 * (x - x0) + tau + 0.25L * ((long double)t * t - (long double)t0 * t0);
+    y[3] = y0[3] + (x - x0);
+}
+
+static const bk_solver_options *default_options(void)
+{
+    static bk_solver_options o;
+    memset(&o, 0, sizeof o);
+    snprintf(o.method, sizeof o.method, "exact");
+    snprintf(o.linear_solver, sizeof o.linear_solver, "auto");
+    o.rtol = 1e-8;
+    o.max_step = NAN;
+    o.max_steps = 100000;
+    return &o;
+}
+
+/* Dense output against the closed form over many decades of w tau, both sides of the
+ * series/closed-form switch, for oscillating, free (w = 0) and nearly free modes; one
+ * back-end restarted for each. */
+static void test_forced_oscillator(void **state)
+{
+    (void)state;
+    const forced cases[] = {{100.0, 0.37, -2.1}, {2.385, -1.5, 0.8}, {0.0, 0.37, -2.1},
+                            {1e-9, 0.2, 0.1}};
+    const bk_solver_backend *b = bk_solver_backend_find("exact");
+    assert_non_null(b);
+    void *mem = NULL;
+    bk_error err = {0};
+    assert_int_equal(b->create(&mem, default_options(), &err), BK_OK);
+    double worst = 0.0;
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        forced f = cases[c];
+        int direction[2] = {0, 0};
+        static const double unit_mass[1] = {1.0};
+        bk_ode_problem p = {.user = &f, .rhs = forced_rhs, .roots = forced_roots, .n_roots = 2,
+                            .root_direction = direction, .n_pairs = 1, .pair_mass = unit_mass,
+                            .affine = 1};
+        const double t0 = 3.25, y0[4] = {0.1, -0.4, 0.5, -0.3};
+        double atol[4] = {1e-12, 1e-12, 1e-12, 1e-12};
+        double t_stop = t0 + 40.0;
+        assert_int_equal(b->start(mem, &p, t0, y0, atol, 4, t_stop, &err), BK_OK);
+        /* Each component's scale over the sweep; the rounding of the phase w tau alone moves
+         * a value by ~eps w tau times that scale, so errors are measured in those units. */
+        double scale[4] = {0, 0, 0, 0};
+        for (int e = -60; e <= 50; ++e) {
+            long double ref[4];
+            forced_exact(&f, t0, y0, t0 + 40.0 * pow(2.0, (double)e / 10.0 - 5.0), ref);
+            for (size_t k = 0; k < 4; ++k)
+                scale[k] = fmax(scale[k], fabs((double)ref[k]));
+        }
+        for (int e = -60; e <= 50; ++e) {
+            double tau = 40.0 * pow(2.0, (double)e / 10.0 - 5.0);
+            double t = t0 + tau, y[4];
+            assert_int_equal(b->interpolate(mem, t, y, &err), BK_OK);
+            long double ref[4];
+            forced_exact(&f, t0, y0, t, ref);
+            for (size_t k = 0; k < 4; ++k) {
+                double units = DBL_EPSILON * (1.0 + f.w * (t - t0)) * scale[k];
+                double e_units = fabs(y[k] - (double)ref[k]) / units;
+                if (e_units > 16.0)
+                    print_error("case %zu tau %.3g component %zu: %.17g vs %.17Lg (%.3g)\n", c,
+                                tau, k, y[k], ref[k], e_units);
+                assert_true(e_units <= 16.0);
+                worst = fmax(worst, e_units);
+            }
+        }
+        /* Outside the segment is an error, not an extrapolation. */
+        double y[4];
+        assert_int_equal(b->interpolate(mem, t0 - 1e-3, y, &err), BK_ERR_SOLVER);
+        assert_int_equal(b->interpolate(mem, t_stop + 1e-3, y, &err), BK_ERR_SOLVER);
+    }
+    print_message("forced oscillator: worst error of the dense output %.3g eps (1 + w tau) "
+                  "times the component's scale\n",
+                  worst);
+    b->destroy(mem);
+}
+
+/* Roots: both directions, every crossing in order, located to a few doubles and reported
+ * just after the crossing; counters. */
+static void test_roots_in_order(void **state)
+{
+    (void)state;
+    const bk_solver_backend *b = bk_solver_backend_find("exact");
+    void *mem = NULL;
+    bk_error err = {0};
+    assert_int_equal(b->create(&mem, default_options(), &err), BK_OK);
+    forced f = {3.0, 0.0, 0.0}; /* x = cos(3 tau), v = -3 sin(3 tau) */
+    int direction[2] = {0, +1};
+    static const double unit_mass[1] = {1.0};
+    bk_ode_problem p = {.user = &f, .rhs = forced_rhs, .roots = forced_roots, .n_roots = 2,
+                        .root_direction = direction, .n_pairs = 1, .pair_mass = unit_mass,
+                        .affine = 1};
+    double y0[4] = {1.0, 0.0, 0.0, 0.0}, atol[4] = {1, 1, 1, 1}, y[4], t;
+    double t_stop = 2.0 * PI / 3.0 * 2.9;
+    assert_int_equal(b->start(mem, &p, 0.0, y0, atol, 4, t_stop, &err), BK_OK);
+    /* v starts at exactly zero: inactive until it moves.  Expected, per period: x = 0.25
+     * falling at acos(0.25)/3, v rising through 0 at pi/3, x = 0.25 rising at
+     * (2 pi - acos(0.25))/3; v's falling zero at 2 pi/3 is not listened to. */
+    double a = acos(0.25) / 3.0;
+    double expect[] = {a, PI / 3.0, 2.0 * PI / 3.0 - a, 2.0 * PI / 3.0 + a, PI,
+                       4.0 * PI / 3.0 - a, 4.0 * PI / 3.0 + a, 5.0 * PI / 3.0, 2.0 * PI - a};
+    int which[] = {0, 1, 0, 0, 1, 0, 0, 1, 0};
+    int dir[] = {-1, +1, +1, -1, +1, +1, -1, +1, +1};
+    size_t k = 0;
+    int rc;
+    while ((rc = b->step(mem, &t, y, &err)) != BK_STEP_STOP) {
+        assert_true(rc == BK_STEP_OK || rc == BK_STEP_ROOT);
+        if (rc != BK_STEP_ROOT)
+            continue;
+        assert_true(k < sizeof expect / sizeof expect[0]);
+        int found[2];
+        assert_int_equal(b->root_info(mem, found), BK_OK);
+        assert_int_equal(found[which[k]], dir[k]);
+        assert_int_equal(found[1 - which[k]], 0);
+        assert_close(t, expect[k], 4.0 * DBL_EPSILON, 0.0);
+        /* after the crossing: the function holds its new sign, or is zero */
+        double g = which[k] == 0 ? y[0] - 0.25 : y[1];
+        assert_true(g * dir[k] >= 0.0);
+        double lo, hi;
+        b->last_step(mem, &lo, &hi);
+        assert_true(lo < t && hi == t);
+        ++k;
+    }
+    assert_int_equal(k, sizeof expect / sizeof expect[0]);
+    assert_true(t == t_stop);
+    /* Stepping after the stop stays there. */
+    assert_int_equal(b->step(mem, &t, y, &err), BK_STEP_STOP);
+    assert_true(t == t_stop);
+    bk_solver_counters c;
+    b->counters(mem, &c);
+    print_message("roots: %ld steps, %ld rhs probes, %ld root evaluations\n", c.steps, c.rhs_evals,
+                  c.root_evals);
+    /* 2.9 periods at 16 samples each, plus one short step per root */
+    assert_true(c.steps >= 47 && c.steps <= 47 + 9);
+    assert_int_equal(c.rhs_evals, 1 + 1 + 1 + 1 + 2); /* f0, position, time, velocity, 2 quadratures */
+    assert_true(c.root_evals > c.steps);
+    assert_int_equal(c.err_test_fails, 0);
+    assert_int_equal(c.nonlin_iters, 0);
+    b->destroy(mem);
+}
+
+/* The sampling step is a sixteenth of the shortest period, or max_step when smaller. */
+static void test_sampling_step(void **state)
+{
+    (void)state;
+    const bk_solver_backend *b = bk_solver_backend_find("exact");
+    const double max_steps[2] = {NAN, 0.05};
+    const long expected[2] = {8, 20}; /* 1 s: period 2 pi / 3 = 2.09 s / 16 = 0.131 s, or 0.05 s */
+    for (int k = 0; k < 2; ++k) {
+        bk_solver_options o = *default_options();
+        o.max_step = max_steps[k];
+        void *mem = NULL;
+        bk_error err = {0};
+        assert_int_equal(b->create(&mem, &o, &err), BK_OK);
+        forced f = {3.0, 0.0, 0.0};
+        static const double unit_mass[1] = {1.0};
+        bk_ode_problem p = {.user = &f, .rhs = forced_rhs, .n_pairs = 1, .pair_mass = unit_mass,
+                            .affine = 1};
+        double y0[4] = {1.0, 0.0, 0.0, 0.0}, atol[4] = {1, 1, 1, 1}, y[4], t = 0.0, lo, hi;
+        assert_int_equal(b->start(mem, &p, 0.0, y0, atol, 4, 1.0, &err), BK_OK);
+        int rc;
+        double longest = 0.0;
+        while ((rc = b->step(mem, &t, y, &err)) == BK_STEP_OK) {
+            b->last_step(mem, &lo, &hi);
+            longest = fmax(longest, hi - lo);
+        }
+        assert_int_equal(rc, BK_STEP_STOP);
+        bk_solver_counters c;
+        b->counters(mem, &c);
+        assert_int_equal(c.steps, expected[k]);
+        assert_true(longest <= (k == 0 ? 2.0 * PI / 3.0 / 16.0 : 0.05) * (1.0 + 1e-12));
+        b->destroy(mem);
+    }
+}
+
+/* Problems the exact stepper cannot solve are refused at start with a clear message. */
+static int damped_rhs(double t, const double *y, double *ydot, void *user)
+{
+    (void)t;
+    (void)user;
+    ydot[0] = y[1];
+    ydot[1] = -4.0 * y[0] - 0.1 * y[1];
+    return 0;
+}
+
+static int growing_rhs(double t, const double *y, double *ydot, void *user)
+{
+    (void)t;
+    (void)user;
+    ydot[0] = y[1];
+    ydot[1] = -4.0 * y[0];
+    ydot[2] = y[2]; /* grows with itself: no quadrature */
+    return 0;
+}
+
+static void test_refuses_non_affine(void **state)
+{
+    (void)state;
+    const bk_solver_backend *b = bk_solver_backend_find("exact");
+    void *mem = NULL;
+    bk_error err = {0};
+    assert_int_equal(b->create(&mem, default_options(), &err), BK_OK);
+    forced f = {2.0, 0.0, 0.0};
+    static const double masses[2] = {1.0, 1.0};
+    double y0[4] = {1, 0, 0, 0}, atol[4] = {1, 1, 1, 1};
+
+    /* What the run loop hands over for a friction law that is not constant-sliding. */
+    bk_ode_problem p = {.user = &f, .rhs = forced_rhs, .n_pairs = 1, .pair_mass = masses,
+                        .affine = 0};
+    assert_int_equal(b->start(mem, &p, 0.0, y0, atol, 4, 1.0, &err), BK_ERR_CONFIG);
+    print_message("affine = 0: %s\n", err.message);
+    assert_non_null(strstr(err.message, "method exact needs Coulomb friction"));
+    assert_non_null(strstr(err.message, "use cvode_adams or cvode_bdf"));
+
+    /* Declared affine, but the acceleration depends on the velocity (damping). */
+    bk_ode_problem damped = {.rhs = damped_rhs, .n_pairs = 1, .pair_mass = masses, .affine = 1};
+    assert_int_equal(b->start(mem, &damped, 0.0, y0, atol, 2, 1.0, &err), BK_ERR_CONFIG);
+    print_message("damped: %s\n", err.message);
+    assert_non_null(strstr(err.message, "depends on the velocity"));
+
+    /* A trailing component whose rate depends on itself. */
+    bk_ode_problem growing = {.rhs = growing_rhs, .n_pairs = 1, .pair_mass = masses, .affine = 1};
+    assert_int_equal(b->start(mem, &growing, 0.0, y0, atol, 3, 1.0, &err), BK_ERR_CONFIG);
+    print_message("growing: %s\n", err.message);
+    assert_non_null(strstr(err.message, "quadrature"));
+
+    /* Pairs that do not fit the state. */
+    p.affine = 1;
+    p.n_pairs = 2;
+    assert_int_equal(b->start(mem, &p, 0.0, y0, atol, 3, 1.0, &err), BK_ERR_CONFIG);
+    assert_non_null(strstr(err.message, "pairs"));
+
+    /* After a refusal the same back-end still solves a good problem. */
+    p.n_pairs = 1;
+    double y[4], t;
+    assert_int_equal(b->start(mem, &p, 0.0, y0, atol, 4, 1.0, &err), BK_OK);
+    assert_int_equal(b->step(mem, &t, y, &err), BK_STEP_OK);
+    assert_close(y[0], cos(2.0 * t), 1e-15, 1e-16);
+    b->destroy(mem);
+}
+
+/* --- the paper's single block ------------------------------------------------------------ */
+
+typedef struct single_errors {
+    double time, position, slip_duration, slip_distance, stick_duration, energy;
+    double stick_ulps; /* worst stick-duration error in units of eps t */
+} single_errors;
+
+static void compare_single(double mu_d, bk_spring spring)
+{
+    scene_spec spec = paper_case(mu_d, spring, "exact");
+    exact_params p = {1.0, 1e4, 9.81, 0.6, mu_d, 1e-3, spring == BK_SPRING_TENSION_ONLY};
+    exact_solution ex;
+    assert_int_equal(exact_solve(&p, spec.t_end, &ex), 0);
+    bk_config *c = make_config(&spec);
+    recorder r = {0};
+    bk_run_stats stats;
+    bk_error err = {0};
+    assert_int_equal(run_config(c, &r, &stats, &err), BK_OK);
+    assert_int_equal(r.n_transitions, ex.n_events);
+    assert_false(r.time_decreased);
+    single_errors e = {0};
+    for (size_t k = 0; k < ex.n_events; ++k) {
+        const bk_transition *tr = &r.transitions[k];
+        const exact_event *ev = &ex.events[k];
+        assert_int_equal(tr->from, ev->from);
+        assert_int_equal(tr->to, ev->to);
+        e.time = fmax(e.time, relative(tr->t, ev->t));
+        e.position = fmax(e.position, relative(tr->x, ev->x));
+        if (k + 1 == ex.n_events)
+            continue;
+        double duration = r.transitions[k + 1].t - tr->t, exact_duration = ex.events[k + 1].t - ev->t;
+        if (ev->to == BK_MODE_STICK) {
+            /* Case C's sticks last 0.2 ms: 1e-12 of that is below the spacing of doubles
+             * near t = 1..5 s (eps t = 2e-16..1.1e-15 s), so the duration of a stick that ends
+             * at t is held to 1e-12 relative or 2 eps t, whichever is larger. */
+            double error = fabs(duration - exact_duration);
+            double t_end_stick = ex.events[k + 1].t;
+            e.stick_duration = fmax(e.stick_duration, relative(duration, exact_duration));
+            e.stick_ulps = fmax(e.stick_ulps, error / (DBL_EPSILON * t_end_stick));
+            assert_true(error <= fmax(1e-12 * exact_duration, 2.0 * DBL_EPSILON * t_end_stick));
+        } else {
+            e.slip_duration = fmax(e.slip_duration, relative(duration, exact_duration));
+            e.slip_distance = fmax(e.slip_distance, relative(r.transitions[k + 1].x - tr->x,
+                                                             ex.events[k + 1].x - ev->x));
+        }
+    }
+    e.energy = fabs(stats.energy_residual);
+    print_message("mu_d %-6g %-12s %3zu transitions: worst relative error of times %.2g, "
+                  "positions %.2g, slip durations %.2g, slip distances %.2g, stick durations "
+                  "%.2g (%.2g eps t); energy residual %.2g\n",
+                  mu_d, spring == BK_SPRING_LINEAR ? "linear" : "tension-only", ex.n_events,
+                  e.time, e.position, e.slip_duration, e.slip_distance, e.stick_duration,
+                  e.stick_ulps, e.energy);
+    assert_true(e.time <= 1e-12);
+    assert_true(e.position <= 1e-12);
+    assert_true(e.slip_duration <= 1e-12);
+    assert_true(e.slip_distance <= 1e-12);
+    assert_true(e.energy <= 1e-12);
+    recorder_free(&r);
+    free_config(c);
+    exact_free(&ex);
+}
+
+static void test_case_a_linear(void **state)
+{
+    (void)state;
+    compare_single(0.1, BK_SPRING_LINEAR);
+}
+static void test_case_b_linear(void **state)
+{
+    (void)state;
+    compare_single(0.5, BK_SPRING_LINEAR);
+}
+static void test_case_c_linear(void **state)
+{
+    (void)state;
+    compare_single(0.5999, BK_SPRING_LINEAR);
+}
+static void test_case_a_tension_only(void **state)
+{
+    (void)state;
+    compare_single(0.1, BK_SPRING_TENSION_ONLY);
+}
+static void test_case_b_tension_only(void **state)
+{
+    (void)state;
+    compare_single(0.5, BK_SPRING_TENSION_ONLY);
+}
+static void test_case_c_tension_only(void **state)
+{
+    (void)state;
+    compare_single(0.5999, BK_SPRING_TENSION_ONLY);
+}
+
+/* Identical twins: each breakaway and each stop is one event for both blocks. */
+static void test_simultaneous_transitions(void **state)
+{
+    (void)state;
+    scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, "exact");
+    spec.n = 2;
+    spec.coupling = 3e3;
+    bk_config *c = make_config(&spec);
+    recorder r = {0};
+    bk_error err = {0};
+    assert_int_equal(run_config(c, &r, NULL, &err), BK_OK);
+    assert_int_equal(r.n_transitions, 20);
+    for (size_t k = 0; k + 1 < r.n_transitions; k += 2) {
+        assert_true(r.transitions[k].t == r.transitions[k + 1].t);
+        assert_int_equal(r.transitions[k].block, 0);
+        assert_int_equal(r.transitions[k + 1].block, 1);
+        assert_int_equal(r.transitions[k].to, r.transitions[k + 1].to);
+    }
+    recorder_free(&r);
+    free_config(c);
+}
+
+/* A block launched at 0.5 m/s with the driver at rest swings back past its threshold: the
+ * stop (slip rate s v, not from rest) is a reversal slip+ -> slip- at
+ * t = atan(v0 w m / f_k) / w exactly. */
+static void test_reversal(void **state)
+{
+    (void)state;
+    scene_spec spec = paper_case(0.05, BK_SPRING_LINEAR, "exact");
+    spec.velocity = 0.0;
+    spec.t_end = 0.2;
+    bk_config *c = make_config(&spec);
+    c->model->blocks[0].v_init = 0.5;
+    recorder r = {0};
+    bk_run_stats stats;
+    bk_error err = {0};
+    assert_int_equal(run_config(c, &r, &stats, &err), BK_OK);
+    assert_true(r.n_transitions >= 2);
+    assert_int_equal(r.transitions[0].from, BK_MODE_SLIP_POS);
+    assert_int_equal(r.transitions[0].to, BK_MODE_SLIP_NEG);
+    double w = 100.0, fk = 0.05 * 9.81;
+    double t_stop = atan(0.5 * w / fk) / w;
+    double x_stop = -fk / (w * w) * (1.0 - cos(w * t_stop)) + 0.5 / w * sin(w * t_stop);
+    print_message("reversal at %.17g s (exact %.17g), x %.17g m (exact %.17g), energy residual %.2g\n",
+                  r.transitions[0].t, t_stop, r.transitions[0].x, x_stop, stats.energy_residual);
+    assert_close(r.transitions[0].t, t_stop, 4.0 * DBL_EPSILON, 0.0);
+    assert_close(r.transitions[0].x, x_stop, 1e-14, 0.0);
+    assert_true(fabs(stats.energy_residual) <= 1e-13);
+    recorder_free(&r);
+    free_config(c);
+}
+
+/* No driver springs: the pair slides on its coupling alone, with a free (w = 0) mode next to
+ * an oscillating one, until both stop; CVODE at rtol 1e-12 agrees. */
+static void test_free_mode(void **state)
+{
+    (void)state;
+    recorder r[2] = {{0}, {0}};
+    bk_run_stats stats[2];
+    const char *methods[2] = {"exact", "cvode_adams"};
+    for (int k = 0; k < 2; ++k) {
+        scene_spec spec = paper_case(0.3, BK_SPRING_LINEAR, methods[k]);
+        spec.n = 2;
+        spec.stiffness = 0.0;
+        spec.coupling = 2e4;
+        spec.velocity = 0.0;
+        spec.t_end = 0.5;
+        spec.rtol = 1e-12;
+        bk_config *c = make_config(&spec);
+        c->model->blocks[0].v_init = 0.4;
+        c->model->blocks[1].v_init = 0.1;
+        bk_error err = {0};
+        assert_int_equal(run_config(c, &r[k], &stats[k], &err), BK_OK);
+        free_config(c);
+    }
+    assert_true(r[0].n_transitions >= 2);
+    assert_int_equal(r[0].n_transitions, r[1].n_transitions);
+    double worst = 0.0;
+    for (size_t k = 0; k < r[0].n_transitions; ++k) {
+        assert_int_equal(r[0].transitions[k].block, r[1].transitions[k].block);
+        assert_int_equal(r[0].transitions[k].to, r[1].transitions[k].to);
+        worst = fmax(worst, relative(r[0].transitions[k].t, r[1].transitions[k].t));
+    }
+    print_message("free mode: %zu transitions, times agree with CVODE to %.2g; energy residual %.2g\n",
+                  r[0].n_transitions, worst, stats[0].energy_residual);
+    assert_true(worst <= 1e-8);
+    assert_true(fabs(stats[0].energy_residual) <= 1e-12);
+    recorder_free(&r[0]);
+    recorder_free(&r[1]);
+}
+
+/* --- chains against CVODE ---------------------------------------------------------------- */
+
+/* Kinetic coefficients 0.45..0.49 along the chain; with tension-only springs 0.10..0.30,
+ * so that slipping blocks overtake the driver and their springs go slack. */
+static bk_config *chain_config(bk_spring spring, bk_boundary boundary, const char *method,
+                               double rtol, double t_end)
+{
+    scene_spec spec = paper_case(0.5, spring, method);
+    spec.n = 10;
+    spec.coupling = 2e4;
+    spec.boundary = boundary;
+    spec.rtol = rtol;
+    spec.t_end = t_end;
+    bk_config *c = make_config(&spec);
+    for (size_t i = 0; i < spec.n; ++i) {
+        c->model->blocks[i].x_init = 1e-5 * sin(2.385 * (double)i);
+        c->model->blocks[i].friction_params[1] = spring == BK_SPRING_LINEAR
+                                                      ? 0.45 + 0.01 * (double)(i % 5)
+                                                      : 0.10 + 0.05 * (double)(i % 5);
+    }
+    return c;
+}
+
+#define CHAIN_COMPARED 50
+
+static void test_chains_against_cvode(void **state)
+{
+    (void)state;
+    const bk_spring springs[] = {BK_SPRING_LINEAR, BK_SPRING_TENSION_ONLY};
+    const bk_boundary boundaries[] = {BK_BOUNDARY_FREE, BK_BOUNDARY_FIXED, BK_BOUNDARY_PERIODIC};
+    const char *boundary_names[] = {"free", "fixed", "periodic"};
+    for (size_t s = 0; s < 2; ++s)
+        for (size_t b = 0; b < 3; ++b) {
+            /* the slower tension-only chains need longer for as many transitions */
+            double t_end = springs[s] == BK_SPRING_LINEAR ? 1.0 : 2.0;
+            bk_config *ce = chain_config(springs[s], boundaries[b], "exact", 1e-10, t_end);
+            bk_config *cc = chain_config(springs[s], boundaries[b], "cvode_adams", 1e-12, t_end);
+            recorder re = {0}, rc = {0};
+            bk_run_stats se, sc;
+            bk_error err = {0};
+            assert_int_equal(run_config(ce, &re, &se, &err), BK_OK);
+            assert_int_equal(run_config(cc, &rc, &sc, &err), BK_OK);
+            assert_true(re.n_transitions >= CHAIN_COMPARED);
+            assert_true(rc.n_transitions >= CHAIN_COMPARED);
+            double worst = 0.0;
+            for (size_t k = 0; k < CHAIN_COMPARED; ++k) {
+                const bk_transition *a = &re.transitions[k], *c = &rc.transitions[k];
+                assert_int_equal(a->block, c->block);
+                assert_int_equal(a->from, c->from);
+                assert_int_equal(a->to, c->to);
+                worst = fmax(worst, relative(a->t, c->t));
+            }
+            print_message("10 blocks, %s spring, %s ends: %zu / %zu transitions (exact / CVODE), "
+                          "%ld restarts, first %d agree, times to %.2g relative; energy residual "
+                          "exact %.2g, CVODE %.2g\n",
+                          springs[s] == BK_SPRING_LINEAR ? "linear" : "tension-only",
+                          boundary_names[b], re.n_transitions, rc.n_transitions,
+                          se.integrator_starts, CHAIN_COMPARED, worst, se.energy_residual,
+                          sc.energy_residual);
+            assert_true(worst <= 1e-7);
+            assert_true(fabs(se.energy_residual) <= 1e-11);
+            assert_true(re.max_balance_error <= 1e-11 * re.max_work);
+            assert_false(re.time_decreased);
+            recorder_free(&re);
+            recorder_free(&rc);
+            free_config(ce);
+            free_config(cc);
+        }
+}
+
+/* --- speed (reported only) --------------------------------------------------------------- */
+
+static double cpu_time_of(bk_config *c, long *transitions)
+{
+    recorder r = {0};
+    bk_run_stats stats;
+    bk_error err = {0};
+    assert_int_equal(run_config(c, &r, &stats, &err), BK_OK);
+    *transitions = (long)r.n_transitions;
+    recorder_free(&r);
+    return stats.cpu_time;
+}
+
+static void test_timing(void **state)
+{
+    (void)state;
+    for (int which = 0; which < 2; ++which) {
+        double t_exact = 0.0, t_cvode = 0.0;
+        long n_exact = 0, n_cvode = 0;
+        for (int rep = 0; rep < 3; ++rep) {
+            bk_config *ce, *cc;
+            if (which == 0) {
+                scene_spec a = paper_case(0.5, BK_SPRING_LINEAR, "exact");
+                scene_spec b = paper_case(0.5, BK_SPRING_LINEAR, "cvode_adams");
+                ce = make_config(&a);
+                cc = make_config(&b);
+            } else {
+                ce = chain_config(BK_SPRING_LINEAR, BK_BOUNDARY_FREE, "exact", 1e-10, 1.0);
+                cc = chain_config(BK_SPRING_LINEAR, BK_BOUNDARY_FREE, "cvode_adams", 1e-10, 1.0);
+            }
+            t_exact += cpu_time_of(ce, &n_exact);
+            t_cvode += cpu_time_of(cc, &n_cvode);
+            free_config(ce);
+            free_config(cc);
+        }
+        print_message("%s: exact %.3g s, cvode_adams (rtol 1e-10) %.3g s CPU per run, ratio "
+                      "cvode/exact %.2g (%ld / %ld transitions)\n",
+                      which == 0 ? "case B, 5 s" : "10-block chain, 1 s", t_exact / 3.0,
+                      t_cvode / 3.0, t_exact > 0.0 ? t_cvode / t_exact : INFINITY, n_exact, n_cvode);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_forced_oscillator),
+        cmocka_unit_test(test_roots_in_order),
+        cmocka_unit_test(test_sampling_step),
+        cmocka_unit_test(test_refuses_non_affine),
+        cmocka_unit_test(test_case_a_linear),
+        cmocka_unit_test(test_case_b_linear),
+        cmocka_unit_test(test_case_c_linear),
+        cmocka_unit_test(test_case_a_tension_only),
+        cmocka_unit_test(test_case_b_tension_only),
+        cmocka_unit_test(test_case_c_tension_only),
+        cmocka_unit_test(test_simultaneous_transitions),
+        cmocka_unit_test(test_reversal),
+        cmocka_unit_test(test_free_mode),
+        cmocka_unit_test(test_chains_against_cvode),
+        cmocka_unit_test(test_timing),
+    };
+    return cmocka_run_group_tests_name("exact", tests, NULL, NULL);
+}
