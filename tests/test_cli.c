@@ -682,6 +682,100 @@ static void test_limits(void **state)
     }
 }
 
+/* Every dataset of two output files, value for value. */
+static void assert_same_output(const char *a, const char *b)
+{
+    static const char *const names[] = {"time", "driver", "event", "x", "v", "friction", "cof", "mode",
+                                        "energy_kinetic", "energy_elastic", "work_driver", "dissipation"};
+    bk_error err = {0};
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; ++k) {
+        double *da = NULL, *db = NULL;
+        size_t ra, ca, rb, cb;
+        assert_int_equal(bk_h5_read_doubles(a, names[k], &da, &ra, &ca, &err), BK_OK);
+        assert_int_equal(bk_h5_read_doubles(b, names[k], &db, &rb, &cb, &err), BK_OK);
+        assert_int_equal(ra, rb);
+        assert_int_equal(ca, cb);
+        assert_memory_equal(da, db, ra * ca * sizeof *da);
+        free(da);
+        free(db);
+    }
+    bk_transition *ta = NULL, *tb = NULL;
+    size_t na, nb;
+    assert_int_equal(bk_h5_read_transitions(a, &ta, &na, &err), BK_OK);
+    assert_int_equal(bk_h5_read_transitions(b, &tb, &nb, &err), BK_OK);
+    assert_int_equal(na, nb);
+    for (size_t k = 0; k < na; ++k) {
+        assert_true(ta[k].t == tb[k].t && ta[k].x == tb[k].x && ta[k].force == tb[k].force);
+        assert_int_equal(ta[k].block, tb[k].block);
+        assert_int_equal(ta[k].to, tb[k].to);
+    }
+    free(ta);
+    free(tb);
+}
+
+/* A run stopped again and again and restarted from its checkpoints each time ends with the
+ * very output of an uninterrupted run: every row and transition bit-identical. */
+static void test_restart_equivalence(void **state)
+{
+    (void)state;
+    const char *methods[] = {"cvode_adams", "exact"};
+    for (size_t m = 0; m < 2; ++m) {
+        char reference[512], stopped[512], part[600], cmd[2048];
+        snprintf(reference, sizeof reference, "%s/reference_%s.h5", tmpdir, methods[m]);
+        snprintf(stopped, sizeof stopped, "%s/stopped_%s.h5", tmpdir, methods[m]);
+        snprintf(part, sizeof part, "%s.part", stopped);
+        const char *common = "configs/paper/case_b_coulomb.ini --quiet --set output.checkpoint_interval=0.1";
+        snprintf(cmd, sizeof cmd, "./bksim run %s --set solver.method=%s -o %s", common, methods[m], reference);
+        assert_int_equal(run(cmd, NULL), 0);
+        /* The same run under a wall-clock limit so short that it stops many times (each
+         * invocation still passes a checkpoint, or it could not progress). */
+        snprintf(cmd, sizeof cmd, "./bksim run %s --set solver.method=%s --set run.wall_time_limit=0.02 -o %s",
+                 common, methods[m], stopped);
+        int status = run(cmd, NULL);
+        int restarts = 0;
+        while (status == 1 && restarts < 500) {
+            snprintf(cmd, sizeof cmd, "./bksim run --restart %s --quiet", part);
+            status = run(cmd, NULL);
+            ++restarts;
+        }
+        print_message("%s: finished after %d restarts\n", methods[m], restarts);
+        assert_int_equal(status, 0);
+        assert_true(restarts >= 1);
+        assert_false(exists(part));
+        assert_same_output(reference, stopped);
+        bk_error err = {0};
+        assert_int_equal(bk_h5_verify(stopped, &err), BK_OK);
+    }
+}
+
+static void test_restart_errors(void **state)
+{
+    (void)state;
+    char out[512], cmd[2048];
+    char *text = NULL;
+    snprintf(out, sizeof out, "%s/no_checkpoint.h5", tmpdir);
+    snprintf(cmd, sizeof cmd,
+             "./bksim run configs/paper/case_b_coulomb.ini -o %s -q --set run.wall_time_limit=1e-4", out);
+    assert_int_equal(run(cmd, NULL), 1);
+    snprintf(cmd, sizeof cmd, "./bksim run --restart %s.part", out);
+    assert_int_equal(run(cmd, &text), 2);
+    assert_non_null(strstr(text, "no checkpoint to restart from (run with [output] checkpoint_interval > 0)"));
+    free(text);
+    snprintf(cmd, sizeof cmd, "./bksim run configs/paper/case_a_coulomb.ini -q -o %s/finished.h5 "
+                              "--set output.checkpoint_interval=1 && ./bksim run --restart %s/finished.h5",
+             tmpdir, tmpdir);
+    assert_int_equal(run(cmd, &text), 2);
+    assert_non_null(strstr(text, "the run is complete, nothing to restart"));
+    free(text);
+    snprintf(cmd, sizeof cmd, "./bksim run --restart %s/nothing.h5", tmpdir);
+    assert_int_equal(run(cmd, &text), 2);
+    assert_non_null(strstr(text, "no such file to restart from"));
+    free(text);
+    assert_int_equal(run("./bksim run configs/paper/case_b_coulomb.ini --restart x.h5", &text), 2);
+    assert_non_null(strstr(text, "--restart takes no CONFIG"));
+    free(text);
+}
+
 /* README's config reference is exactly what `bksim keys` prints. */
 static void test_readme_reference_current(void **state)
 {
@@ -720,6 +814,8 @@ int main(void)
         cmocka_unit_test(test_killed_run_leaves_partial),
         cmocka_unit_test(test_damaged_files),
         cmocka_unit_test(test_limits),
+        cmocka_unit_test(test_restart_equivalence),
+        cmocka_unit_test(test_restart_errors),
         cmocka_unit_test(test_readme_reference_current),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);
