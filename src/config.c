@@ -129,6 +129,8 @@ static const key_def keys[] = {
      BK_KEY_FIELDS, field_names, NULL, "all"},
     {"output", {"transitions", "", 1, 0, 1, 0, "write the /transitions table"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
     {"output", {"event_rows", "", 1, 0, 1, 0, "add a row at every transition instant"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
+    INT("output", "max_rows", 1e8, 1, 1e15, 0,
+        "largest number of sample rows (t_end / interval) a run may write: a guard against a typo in interval"),
     NUM("output", "checkpoint_interval", "s", 0.0, 0.0, INFINITY, 0,
         "time between checkpoints, from which `bksim run --restart` continues (0: none)"),
 
@@ -863,6 +865,11 @@ static void build_prescribed(loader *ld, bk_config *c)
         }
         pr->duration[k] = durations ? durations->list[k] : distances->list[k] / rate;
         total += pr->duration[k];
+        if (!isfinite(total)) {
+            report_entry(ld, lengths, "segment %zu makes the schedule longer than any finite time "
+                         "(allowed: a finite total duration)", k + 1);
+            return;
+        }
         if (first_rate == 0.0)
             first_rate = rate;
     }
@@ -934,6 +941,17 @@ static bk_config *build(loader *ld)
     o->transitions = (int)value_of(ld, "output", "transitions");
     o->event_rows = (int)value_of(ld, "output", "event_rows");
     o->checkpoint_interval = value_of(ld, "output", "checkpoint_interval");
+    o->max_rows = (long)value_of(ld, "output", "max_rows");
+    double samples = o->interval > 0.0 ? c->t_end / o->interval : 0.0;
+    if (samples > (double)o->max_rows) {
+        if (interval)
+            report_entry(ld, interval, "gives %.3g rows over t_end = %g s, more than [output] max_rows = %ld "
+                         "(allowed: >= %g s, or raise max_rows)", samples, c->t_end, o->max_rows,
+                         c->t_end / (double)o->max_rows);
+        else
+            report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [output] interval: the default t_end / 1000 gives "
+                   "more than [output] max_rows = %ld rows", ld->name, o->max_rows);
+    }
     return c;
 }
 

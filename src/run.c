@@ -91,6 +91,8 @@ static double sample_time(const run_ctx *ctx, long k)
     return t >= ctx->t_end - 1e-9 * ctx->interval ? ctx->t_end : t;
 }
 
+static double wall_seconds(void);
+
 /* Emit one row from the scene's unpacked state at time t. */
 static int emit_row(run_ctx *ctx, double t, int is_event)
 {
@@ -120,6 +122,12 @@ static int emit_row(run_ctx *ctx, double t, int is_event)
     ctx->t_last_row = t;
     ctx->steps_since_row = 0;
     ctx->stats->rows++;
+    /* Rows can come without steps (all stuck, or dense sampling): the wall clock is
+     * checked here too. */
+    double limit = ctx->config->wall_time_limit;
+    if (limit > 0.0 && wall_seconds() - ctx->wall_start > limit)
+        return BK_FAIL(ctx->err, BK_ERR_INTERRUPTED,
+                       "[run] wall_time_limit = %g s reached at t = %.17g s of %g s", limit, t, ctx->t_end);
     if (ctx->sink && ctx->sink->sample) {
         int rc = ctx->sink->sample(ctx->sink->self, &sample, ctx->err);
         if (rc != BK_OK)

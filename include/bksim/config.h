@@ -45,6 +45,7 @@ typedef struct bk_output_options {
     int transitions;   /* write /transitions; default 1 */
     int event_rows;    /* add a row at every transition instant; default 1 */
     double checkpoint_interval; /* s between checkpoints (restart points); 0 = none (default) */
+    long max_rows;     /* sample rows t_end / interval may ask for; default 1e8 */
 } bk_output_options;
 
 /* A prescribed-motion scene (no dynamics): one block slides at a piecewise-constant slip
