@@ -70,5 +70,17 @@ extern const bk_solver_backend bk_solver_cvode_adams;
 extern const bk_solver_backend bk_solver_cvode_bdf;
 /* Exact piecewise-analytic (modal) stepper: affine problems only (Coulomb friction). */
 extern const bk_solver_backend bk_solver_exact;
+/* ARKODE ARKStep (src/solver/arkode.c) */
+extern const bk_solver_backend bk_solver_arkode_bs23;
+extern const bk_solver_backend bk_solver_arkode_dp45;
+extern const bk_solver_backend bk_solver_arkode_erk;
+extern const bk_solver_backend bk_solver_arkode_dirk;
+extern const bk_solver_backend bk_solver_arkode_imex;
+/* IDA on the residual y' - f(t, y) (src/solver/ida.c) */
+extern const bk_solver_backend bk_solver_ida;
+/* GSL odeiv2 with event location by bksim (src/solver/gsl.c) */
+extern const bk_solver_backend bk_solver_gsl_rk8pd;
+extern const bk_solver_backend bk_solver_gsl_rkf45;
+extern const bk_solver_backend bk_solver_gsl_msbdf;
 
 #endif
