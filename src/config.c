@@ -38,11 +38,14 @@ static const char *const spring_names[] = {"linear", "tension_only", NULL};
 static const char *const linear_solver_names[] = {"auto", "dense", "band", NULL};
 static const char *const field_names[] = {"x", "v", "friction", "cof", "mode", "energy", "state", NULL};
 
+/* "auto" (resolved by the run loop from the scene), then every registered back-end. */
 static const char *method_name(size_t i)
 {
+    if (i == 0)
+        return "auto";
     const bk_solver_backend *const *b = bk_solver_backends();
     for (size_t k = 0; b[k]; ++k)
-        if (k == i)
+        if (k + 1 == i)
             return b[k]->name;
     return NULL;
 }
@@ -96,7 +99,9 @@ static const key_def keys[] = {
     NUM("driver", "start_position", "m", 0.0, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
         "driver position at t = 0 (0: at the relaxed blocks)"),
 
-    {"solver", {"method", "", 0, 0, 0, 0, "integrator back-end"}, BK_KEY_CHOICE, NULL, method_name, "cvode_adams"},
+    {"solver", {"method", "", 0, 0, 0, 0,
+                "integrator back-end; auto: exact for Coulomb scenes, cvode_bdf with friction state, else cvode_adams"},
+     BK_KEY_CHOICE, NULL, method_name, "auto"},
     {"solver", {"linear_solver", "", 0, 0, 0, 0, "linear solver of implicit methods: auto (band for long chains), dense, band"},
      BK_KEY_CHOICE, linear_solver_names, NULL, "auto"},
     NUM("solver", "rtol", "1", 1e-8, 1e-15, 0.1, 0, "relative tolerance"),

@@ -748,6 +748,19 @@ static double wall_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* method = auto: the cheapest adequate back-end for the scene.  Between transitions a
+ * Coulomb scene is linear with constant coefficients, so the exact stepper is both exact and
+ * the fastest; friction state (rate-and-state: 1/m = 1000, state relaxing at v B / L0) makes
+ * the problem stiff; the rest is non-stiff. */
+static const char *choose_method(const bk_config *config, const bk_scene *scene)
+{
+    if (strcmp(config->solver.method, "auto") != 0)
+        return config->solver.method;
+    if (scene->affine)
+        return "exact";
+    return config->model->n_friction_state > 0 ? "cvode_bdf" : "cvode_adams";
+}
+
 /* The state of a checkpoint, back into the scene (x_ref = x: the run restarts there). */
 static int resume(run_ctx *ctx, const bk_checkpoint *cp)
 {
@@ -820,11 +833,16 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
     memset(ctx.stats, 0, sizeof *ctx.stats);
     snprintf(ctx.stats->method, sizeof ctx.stats->method, "%s", config->solver.method);
 
-    ctx.backend = bk_solver_backend_find(config->solver.method);
-    if (!ctx.backend)
-        return BK_FAIL(err, BK_ERR_CONFIG, "unknown solver method '%s'", config->solver.method);
     if (bk_scene_init(&ctx.scene, ctx.model, config->solver.detect_velocity_extrema) != 0)
         return BK_FAIL(err, BK_ERR_NOMEM, "out of memory for %zu blocks", ctx.model->n_blocks);
+    const char *method = choose_method(config, &ctx.scene);
+    ctx.backend = bk_solver_backend_find(method);
+    if (!ctx.backend) {
+        bk_scene_free(&ctx.scene);
+        return BK_FAIL(err, BK_ERR_CONFIG, "unknown solver method '%s'", method);
+    }
+    if (method != config->solver.method)
+        snprintf(ctx.stats->method, sizeof ctx.stats->method, "%s (auto)", method);
     size_t n = ctx.model->n_blocks;
     size_t max_y = 2 * n + ctx.model->n_friction_state + 2;
     ctx.y = calloc(max_y, sizeof *ctx.y);

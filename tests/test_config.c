@@ -114,7 +114,7 @@ static void test_defaults(void **state)
     assert_int_equal(c->model->spring, BK_SPRING_LINEAR);
     assert_close(c->model->gravity, 9.81, 0, 0);
     assert_close(c->model->blocks[0].normal_force, 9.81, 0, 0);
-    assert_string_equal(c->solver.method, "cvode_adams");
+    assert_string_equal(c->solver.method, "auto");
     assert_string_equal(c->solver.linear_solver, "auto");
     assert_close(c->solver.rtol, 1e-8, 0, 0);
     assert_int_equal(c->solver.max_steps, 100000);
@@ -209,7 +209,7 @@ static void test_rejections(void **state)
         {"t_end = 5\n", "t_end = 5\n[solver]\nrtol = 1\n",
          "t.ini:15: [solver] rtol: out of range, got 1 (allowed: 1e-15 <= rtol <= 0.1)"},
         {"t_end = 5\n", "t_end = 5\n[solver]\nmethod = euler\n",
-         "t.ini:15: [solver] method: unknown value \"euler\" (allowed: cvode_adams, cvode_bdf"},
+         "t.ini:15: [solver] method: unknown value \"euler\" (allowed: auto, cvode_adams, cvode_bdf"},
         {"t_end = 5\n", "t_end = 5\n[solver]\ndetect_velocity_extrema = maybe\n",
          "t.ini:15: [solver] detect_velocity_extrema: not a boolean: \"maybe\" (allowed: true, false, yes, no, on, off, 1, 0)"},
         {"t_end = 5\n", "t_end = 5\n[output]\nfields = x, speed\n",

@@ -531,6 +531,35 @@ static void test_per_block_laws(void **state)
     bk_config_free(c);
 }
 
+/* method = auto picks the exact stepper for Coulomb scenes, BDF with friction state, Adams
+ * otherwise, and says so in the statistics. */
+static void test_auto_method(void **state)
+{
+    (void)state;
+    const struct {
+        const char *friction, *chosen;
+    } cases[] = {
+        {"law = coulomb\nmu_s = 0.6\nmu_d = 0.5\n", "exact (auto)"},
+        {"law = rate_state\nmu_s = 0.6\nmu_d = 0.5\n", "cvode_bdf (auto)"},
+        {"law = carlson_langer\nF0 = 5.5\nsigma = 0.2\nalpha = 3\n", "cvode_adams (auto)"},
+    };
+    for (size_t k = 0; k < 3; ++k) {
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "[model]\nn_blocks = 1\n[block]\nmass = 1\ndriver_stiffness = 1e4\n[friction]\n%s"
+                 "[driver]\nvelocity = 1e-3\n[run]\nt_end = 1\n",
+                 cases[k].friction);
+        bk_config *c = NULL;
+        bk_error err = {0};
+        assert_int_equal(bk_config_load_string(text, "auto.ini", NULL, 0, &c, &err), BK_OK);
+        assert_string_equal(c->solver.method, "auto");
+        bk_run_stats stats;
+        assert_int_equal(bk_run(c, NULL, &stats, NULL, NULL, &err), BK_OK);
+        assert_string_equal(stats.method, cases[k].chosen);
+        bk_config_free(c);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -552,6 +581,7 @@ int main(void)
         cmocka_unit_test(test_interrupt),
         cmocka_unit_test(test_rows),
         cmocka_unit_test(test_per_block_laws),
+        cmocka_unit_test(test_auto_method),
     };
     return cmocka_run_group_tests_name("run", tests, NULL, NULL);
 }
