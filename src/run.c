@@ -814,6 +814,7 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
     run_ctx ctx;
     memset(&ctx, 0, sizeof ctx);
     bk_run_stats local_stats;
+    memset(&local_stats, 0, sizeof local_stats);
     ctx.config = config;
     ctx.model = config->model;
     ctx.sink = sink;
@@ -866,6 +867,7 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
     ctx.problem = (bk_ode_problem){
         .user = &ctx.scene,
         .rhs = bk_scene_rhs,
+        .jacobian = bk_scene_jacobian,
         .roots = bk_scene_roots,
         .n_roots = n * ctx.scene.roots_per_block,
         .root_direction = ctx.scene.root_direction,

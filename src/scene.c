@@ -275,6 +275,86 @@ int bk_scene_rhs(double t, const double *y, double *ydot, void *user)
     return 0;
 }
 
+/* d(sliding force)/d(slip rate) and d/d(state) of block i (N s/m, N per state unit). */
+static void friction_derivatives(const bk_scene *scene, size_t i, double slip_rate, const double *state,
+                                 double *d_rate, double *d_state)
+{
+    const bk_block *b = &scene->model->blocks[i];
+    const bk_friction_law *law = b->law;
+    double h = 1e-6 * fmax(fabs(slip_rate), 1e-9);
+    *d_rate = (law->sliding_force(b->friction_params, scene->normal[i], slip_rate + h, state) -
+               law->sliding_force(b->friction_params, scene->normal[i], slip_rate - h, state)) /
+              (2.0 * h);
+    if (law->n_state == 0) {
+        *d_state = 0.0;
+        return;
+    }
+    double shifted[BK_FRICTION_MAX_STATE];
+    double hs = 1e-6 * fmax(fabs(state[0]), 1e-12);
+    shifted[0] = state[0] + hs;
+    double up = law->sliding_force(b->friction_params, scene->normal[i], slip_rate, shifted);
+    shifted[0] = state[0] - hs;
+    double down = law->sliding_force(b->friction_params, scene->normal[i], slip_rate, shifted);
+    *d_state = (up - down) / (2.0 * hs);
+}
+
+int bk_scene_jacobian(double t, const double *y, void *user,
+                      void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
+{
+    const bk_scene *scene = user;
+    const bk_model *model = scene->model;
+    double kc = model->coupling_stiffness;
+    double speed = bk_driver_velocity(&model->driver, t);
+    size_t work_row = scene->n_y - 2, dissipation_row = scene->n_y - 1;
+    for (size_t k = 0; k < scene->n_active; ++k) {
+        size_t i = scene->active[k], s = scene->slot[i];
+        const bk_block *b = &model->blocks[i];
+        double dir = (double)scene->mode[i], v_i = y[s + 1], m = b->mass;
+        double spring = model->spring == BK_SPRING_TENSION_ONLY && !scene->taut[i] ? 0.0 : b->driver_stiffness;
+        put(matrix, s, s + 1, 1.0); /* xi' = v */
+        /* Springs: the block's own stiffness, and its slipping partners. */
+        put(matrix, s + 1, s, -(spring + kc * bk_model_coupling_count(model, i)) / m);
+        const long partners[2] = {scene->left[i], scene->right[i]};
+        for (size_t p = 0; p < 2 && kc > 0.0; ++p)
+            if (partners[p] >= 0 && scene->slot[partners[p]] != NO_SLOT)
+                put(matrix, s + 1, scene->slot[partners[p]], kc / m);
+        /* Friction: -dir F(dir v, state) / m. */
+        const double *state = block_state(scene, y, i);
+        double d_rate, d_state;
+        double force = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i, state);
+        friction_derivatives(scene, i, dir * v_i, state, &d_rate, &d_state);
+        put(matrix, s + 1, s + 1, -d_rate / m);
+        if (state)
+            put(matrix, s + 1, scene->state_slot[i], -dir * d_state / m);
+        /* Energy rates: driver power V k (D - x), friction power dir F v. */
+        put(matrix, work_row, s, -speed * spring);
+        put(matrix, dissipation_row, s + 1, dir * force + v_i * d_rate);
+        if (state)
+            put(matrix, dissipation_row, scene->state_slot[i], dir * v_i * d_state);
+    }
+    /* State equations: d(rate)/d(state) and, while slipping, d(rate)/dv. */
+    for (size_t k = 0; k < scene->n_stateful; ++k) {
+        size_t i = scene->stateful[k], q = scene->state_slot[i], s = scene->slot[i];
+        const bk_block *b = &model->blocks[i];
+        double v_i = s == NO_SLOT ? 0.0 : y[s + 1], spd = fabs(v_i);
+        double st[BK_FRICTION_MAX_STATE], up[BK_FRICTION_MAX_STATE], down[BK_FRICTION_MAX_STATE];
+        double hs = 1e-6 * fmax(fabs(y[q]), 1e-12);
+        st[0] = y[q] + hs;
+        b->law->state_rate(b->friction_params, spd, st, up);
+        st[0] = y[q] - hs;
+        b->law->state_rate(b->friction_params, spd, st, down);
+        put(matrix, q, q, (up[0] - down[0]) / (2.0 * hs));
+        if (s != NO_SLOT) {
+            double hv = 1e-6 * fmax(spd, 1e-9);
+            b->law->state_rate(b->friction_params, spd + hv, &y[q], up);
+            b->law->state_rate(b->friction_params, fmax(spd - hv, 0.0), &y[q], down);
+            double d_speed = (up[0] - down[0]) / (spd + hv - fmax(spd - hv, 0.0));
+            put(matrix, q, s + 1, v_i >= 0.0 ? d_speed : -d_speed);
+        }
+    }
+    return 0;
+}
+
 int bk_scene_roots(double t, const double *y, double *g, void *user)
 {
     const bk_scene *scene = user;

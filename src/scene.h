@@ -87,6 +87,10 @@ void bk_scene_unpack(bk_scene *scene, double t, const double *y);
 
 /* The ODE right-hand side and root functions for the current layout (bk_ode_problem). */
 int bk_scene_rhs(double t, const double *y, double *ydot, void *scene);
+/* The exact Jacobian of bk_scene_rhs (see bk_ode_problem.jacobian); friction-law
+ * derivatives by central differences. */
+int bk_scene_jacobian(double t, const double *y, void *scene,
+                      void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix);
 int bk_scene_roots(double t, const double *y, double *g, void *scene);
 
 /* Applied (spring) force on block i with the unpacked positions at driver position D. */

@@ -170,6 +170,70 @@ static void test_tension_only_frozen(void **state)
     bk_model_free(m);
 }
 
+typedef struct dense {
+    size_t n;
+    double *a;
+} dense;
+
+static void put_dense(void *matrix, size_t row, size_t col, double value)
+{
+    dense *d = matrix;
+    d->a[row * d->n + col] += value;
+}
+
+/* The analytic Jacobian matches central differences of the right-hand side, for a chain
+ * mixing Coulomb and the paper's rate-and-state law, tension-only springs, a periodic
+ * wrap, slipping and stuck blocks. */
+static void test_jacobian(void **state)
+{
+    (void)state;
+    bk_model *m = make_chain(4, BK_SPRING_TENSION_ONLY);
+    m->boundary = BK_BOUNDARY_PERIODIC;
+    m->blocks[1].law = &bk_friction_rate_state;
+    m->blocks[2].law = &bk_friction_rate_state;
+    for (size_t i = 1; i <= 2; ++i) {
+        const bk_friction_law *law = m->blocks[i].law;
+        for (size_t k = 0; k < law->n_params; ++k)
+            m->blocks[i].friction_params[k] = law->params[k].default_value;
+        bk_friction_context ctx = {1e-3, 9.81};
+        law->complete(m->blocks[i].friction_params, &ctx);
+    }
+    bk_model_finalize(m);
+    bk_scene s;
+    assert_int_equal(bk_scene_init(&s, m, 1), 0);
+    const double x[4] = {1e-4, -2e-4, 3e-4, 0.5e-4}, v[4] = {3e-3, -2e-3, 0.0, 1e-3};
+    const int8_t modes[4] = {BK_MODE_SLIP_POS, BK_MODE_SLIP_NEG, BK_MODE_STICK, BK_MODE_SLIP_POS};
+    for (size_t i = 0; i < 4; ++i) {
+        s.x[i] = x[i];
+        s.v[i] = v[i];
+        s.mode[i] = modes[i];
+    }
+    double y[16], t = 0.4;
+    bk_scene_restart(&s, t, y);
+    size_t n = s.n_y;
+    dense jac = {n, calloc(n * n, sizeof(double))};
+    assert_non_null(jac.a);
+    assert_int_equal(bk_scene_jacobian(t, y, &s, put_dense, &jac), 0);
+    double up[16], down[16];
+    for (size_t c = 0; c < n; ++c) {
+        double saved = y[c], h = 1e-7 * fmax(fabs(saved), 1e-6);
+        y[c] = saved + h;
+        bk_scene_rhs(t, y, up, &s);
+        y[c] = saved - h;
+        bk_scene_rhs(t, y, down, &s);
+        y[c] = saved;
+        for (size_t r = 0; r < n; ++r) {
+            double fd = (up[r] - down[r]) / (2 * h);
+            double scale = fmax(fabs(fd), fabs(jac.a[r * n + c]));
+            if (fabs(fd - jac.a[r * n + c]) > 1e-5 * scale + 1e-9)
+                fail_msg("J[%zu][%zu] = %.10g, difference quotient %.10g", r, c, jac.a[r * n + c], fd);
+        }
+    }
+    free(jac.a);
+    bk_scene_free(&s);
+    bk_model_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -178,6 +242,7 @@ int main(void)
         cmocka_unit_test(test_roots_clear_of_zero_after_switch),
         cmocka_unit_test(test_minimum_root_arming),
         cmocka_unit_test(test_tension_only_frozen),
+        cmocka_unit_test(test_jacobian),
     };
     return cmocka_run_group_tests_name("scene", tests, NULL, NULL);
 }

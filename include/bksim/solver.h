@@ -28,6 +28,14 @@ typedef struct bk_ode_problem {
     size_t n_pairs;
     const double *pair_mass;
     int affine;
+    /* Optional exact Jacobian d(ydot)/dy for implicit methods: calls put(matrix, row, col,
+     * value) for each non-zero entry (entries for one position add up).  A banded back-end
+     * drops the entries outside its band instead of approximating them by grouped
+     * difference quotients, which would spill rows that depend on everything (the energy
+     * quadratures, a periodic chain's wrap) into the band.  NULL: back-ends use their own
+     * difference quotients. */
+    int (*jacobian)(double t, const double *y, void *user,
+                    void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix);
 } bk_ode_problem;
 
 typedef struct bk_solver_counters {

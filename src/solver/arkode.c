@@ -34,6 +34,7 @@
 #include <sunmatrix/sunmatrix_dense.h>
 
 #include "bksim/solver.h"
+#include "sundials_jacobian.h"
 
 /* Above this size "auto" picks the band solver (when the layout is banded); as cvode.c. */
 #define BAND_THRESHOLD 16
@@ -166,6 +167,18 @@ static int fail(arkode_backend *ark, bk_error *err, const char *what, int flag)
     return BK_ERR_SOLVER;
 }
 
+/* The problem's exact Jacobian (the implicit part is the whole right-hand side). */
+static int jacobian_adapter(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix jac, void *user,
+                            N_Vector tmp1, N_Vector tmp2, N_Vector tmp3)
+{
+    (void)fy;
+    (void)tmp1;
+    (void)tmp2;
+    (void)tmp3;
+    arkode_backend *ark = user;
+    return bk_sundials_jacobian(&ark->problem, t, N_VGetArrayPointer(y), jac, 1.0, 0.0);
+}
+
 static int create(void **mem, const bk_solver_options *options, const ark_variant *variant,
                   bk_error *err)
 {
@@ -249,6 +262,8 @@ static int build_objects(arkode_backend *ark, size_t n, double t0, const double 
         flag = ARKStepSetLinearSolver(ark->arkode, ark->linear_solver, ark->matrix);
         if (flag != ARK_SUCCESS)
             return fail(ark, err, "ARKStepSetLinearSolver", flag);
+        if (ark->problem.jacobian && (flag = ARKStepSetJacFn(ark->arkode, jacobian_adapter)) != ARK_SUCCESS)
+            return fail(ark, err, "ARKStepSetJacFn", flag);
         /* Rebuild the Newton matrix whenever gamma = h a_ii changes.  With ARKODE 6.4.1's
          * default (reuse while |gamma/gamma_old - 1| < 0.2) a step shortened by up to 20%
          * -- e.g. the last one, clipped to the stop time -- is solved with the stale

@@ -20,6 +20,7 @@
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
 #include "bksim/solver.h"
+#include "sundials_jacobian.h"
 
 /* Above this size "auto" picks the band solver (when the layout is banded). */
 #define BAND_THRESHOLD 16
@@ -59,6 +60,17 @@ static int roots_adapter(sunrealtype t, N_Vector y, sunrealtype *g, void *user)
 {
     cvode_backend *cv = user;
     return cv->problem.roots(t, N_VGetArrayPointer(y), g, cv->problem.user);
+}
+
+static int jacobian_adapter(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix jac, void *user,
+                            N_Vector tmp1, N_Vector tmp2, N_Vector tmp3)
+{
+    (void)fy;
+    (void)tmp1;
+    (void)tmp2;
+    (void)tmp3;
+    cvode_backend *cv = user;
+    return bk_sundials_jacobian(&cv->problem, t, N_VGetArrayPointer(y), jac, 1.0, 0.0);
 }
 
 static void add_counters(cvode_backend *cv, bk_solver_counters *c)
@@ -184,6 +196,8 @@ static int build_objects(cvode_backend *cv, size_t n, double t0, const double *y
         flag = CVodeSetLinearSolver(cv->cvode, cv->linear_solver, cv->matrix);
         if (flag != CV_SUCCESS)
             return fail(cv, err, "CVodeSetLinearSolver", flag);
+        if (cv->problem.jacobian && (flag = CVodeSetJacFn(cv->cvode, jacobian_adapter)) != CV_SUCCESS)
+            return fail(cv, err, "CVodeSetJacFn", flag);
     }
     cv->n = n;
     return BK_OK;

@@ -350,12 +350,14 @@ static void free_steppers(gsl_backend *b)
 
 static void free_arrays(gsl_backend *b)
 {
-    double **arrays[] = {&b->y_lo, &b->f_lo, &b->y_hi, &b->f_hi, &b->y_root, &b->y_probe,
-                         &b->atol, &b->work, &b->work2, &b->yerr, &b->g_scan, &b->g_hi,
-                         &b->g_probe, &b->g_root};
-    for (size_t k = 0; k < sizeof arrays / sizeof *arrays; ++k) {
-        free(*arrays[k]);
-        *arrays[k] = NULL;
+    double **owned[] = {&b->y_lo, &b->f_lo, &b->y_hi, &b->f_hi, &b->y_root, &b->y_probe,
+                        &b->atol, &b->work, &b->work2, &b->yerr, &b->g_scan, &b->g_hi,
+                        &b->g_probe, &b->g_root};
+    const size_t n_owned = sizeof(owned) / sizeof(owned[0]);
+    for (size_t k = 0; k < n_owned; ++k) {
+        double **slot = owned[k];
+        free(*slot);
+        *slot = NULL;
     }
     free(b->active);
     free(b->found);

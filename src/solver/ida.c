@@ -28,6 +28,7 @@
 #include <sunmatrix/sunmatrix_dense.h>
 
 #include "bksim/solver.h"
+#include "sundials_jacobian.h"
 
 /* Above this size "auto" picks the band solver (when the layout is banded); as cvode.c. */
 #define BAND_THRESHOLD 16
@@ -102,11 +103,13 @@ static void free_objects(ida_backend *ida)
         SUNLinSolFree(ida->linear_solver);
     if (ida->matrix)
         SUNMatDestroy(ida->matrix);
-    N_Vector *vectors[] = {&ida->y, &ida->yp, &ida->atol, &ida->id, &ida->work};
-    for (size_t k = 0; k < sizeof vectors / sizeof *vectors; ++k) {
-        if (*vectors[k])
-            N_VDestroy(*vectors[k]);
-        *vectors[k] = NULL;
+    N_Vector *owned[] = {&ida->y, &ida->yp, &ida->atol, &ida->id, &ida->work};
+    const size_t n_owned = sizeof(owned) / sizeof(owned[0]);
+    for (size_t k = 0; k < n_owned; ++k) {
+        N_Vector *slot = owned[k];
+        if (*slot)
+            N_VDestroy(*slot);
+        *slot = NULL;
     }
     ida->ida = NULL;
     ida->linear_solver = NULL;
@@ -122,6 +125,19 @@ static int fail(ida_backend *ida, bk_error *err, const char *what, int flag)
             flag_name ? flag_name : "?", ida->message[0] ? ": " : "", ida->message);
     free(flag_name);
     return BK_ERR_SOLVER;
+}
+
+/* d(residual)/dy + cj d(residual)/dy' for the residual y' - f(t, y): cj I - J. */
+static int jacobian_adapter(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector r,
+                            SUNMatrix jac, void *user, N_Vector tmp1, N_Vector tmp2, N_Vector tmp3)
+{
+    (void)yp;
+    (void)r;
+    (void)tmp1;
+    (void)tmp2;
+    (void)tmp3;
+    ida_backend *ida = user;
+    return bk_sundials_jacobian(&ida->problem, t, N_VGetArrayPointer(y), jac, -1.0, cj);
 }
 
 static int create(void **mem, const bk_solver_options *options, bk_error *err)
@@ -183,6 +199,8 @@ static int build_objects(ida_backend *ida, size_t n, double t0, const double *y0
         return BK_FAIL(err, BK_ERR_NOMEM, "IDA: cannot create the linear solver (n = %zu)", n);
     if ((flag = IDASetLinearSolver(ida->ida, ida->linear_solver, ida->matrix)) != IDA_SUCCESS)
         return fail(ida, err, "IDASetLinearSolver", flag);
+    if (ida->problem.jacobian && (flag = IDASetJacFn(ida->ida, jacobian_adapter)) != IDA_SUCCESS)
+        return fail(ida, err, "IDASetJacFn", flag);
     ida->n = n;
     return BK_OK;
 }
