@@ -19,6 +19,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include <gsl/gsl_rng.h>
 #include <ini.h>
 
 #include "bksim/solver.h"
@@ -78,6 +79,8 @@ static const key_def keys[] = {
     NUM("model", "coupling_stiffness", "N/m", 0.0, 0.0, INFINITY, 0, "stiffness of the springs between neighbours"),
     NUM("model", "gravity", "m/s^2", 9.81, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
         "gravitational acceleration, for the default normal force"),
+    INT("model", "seed", 1, 0, 4294967295.0, 0,
+        "seed of the random numbers drawn at load time (x_init_random); same seed, same run"),
 
     NUM("block", "mass", "kg", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE, "block mass"),
     NUM("block", "driver_stiffness", "N/m", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED,
@@ -88,6 +91,8 @@ static const key_def keys[] = {
         "initial displacement from the relaxed configuration"),
     NUM("block", "v_init", "m/s", 0.0, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
         "initial velocity (non-zero: the block starts slipping that way)"),
+    NUM("block", "x_init_random", "m", 0.0, 0.0, INFINITY, 0,
+        "adds a uniform random displacement in [-a, a] to x_init (heterogeneous chains; [model] seed)"),
 
     {"friction", {"law", "", NAN, 0, 0, BK_PARAM_REQUIRED, "friction law; its parameters follow in the same section"},
      BK_KEY_CHOICE, NULL, law_name, NULL},
@@ -795,6 +800,12 @@ static void build_chain(loader *ld, bk_config *c)
     m->driver.start_position = value_of(ld, "driver", "start_position");
 
     static const char *const required[] = {"mass", "driver_stiffness"};
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    if (!rng) {
+        report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+        return;
+    }
+    gsl_rng_set(rng, (unsigned long)value_of(ld, "model", "seed"));
     for (size_t i = 0; i < n; ++i) {
         bk_block *b = &m->blocks[i];
         int given;
@@ -811,11 +822,14 @@ static void build_chain(loader *ld, bk_config *c)
         if (!given)
             b->normal_force = b->mass * m->gravity;
         b->x_init = block_value(ld, i, "x_init", &given);
+        /* Drawn for every block, so a block's value does not depend on its neighbours' keys. */
+        b->x_init += block_value(ld, i, "x_init_random", &given) * (2.0 * gsl_rng_uniform(rng) - 1.0);
         b->v_init = block_value(ld, i, "v_init", &given);
         build_friction(ld, b, i, m->driver.velocity);
         if (ld->error_rank != LONG_MAX && ld->error_rank >= RANK_MISSING)
             break; /* one missing key is enough; don't repeat it for every block */
     }
+    gsl_rng_free(rng);
     bk_model_finalize(m);
     c->t_end = value_of(ld, "run", "t_end");
 }

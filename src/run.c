@@ -523,6 +523,14 @@ static int integrate(run_ctx *ctx, double *t)
             *t = t_event;
             return report_progress(ctx, *t);
         }
+        if (ctx->options.min_step > 0.0 && step == BK_STEP_OK) {
+            double lo, hi;
+            ctx->backend->last_step(ctx->solver, &lo, &hi);
+            if (hi - lo < ctx->options.min_step)
+                return BK_FAIL(ctx->err, BK_ERR_SOLVER,
+                               "the step size fell to %.3g s, below [solver] min_step = %g s, at t = %.17g s",
+                               hi - lo, ctx->options.min_step, t_reached);
+        }
         bk_scene_arm(scene, t_reached, ctx->y);
         if (missed_stop(ctx)) {
             double t_event = t_reached;
@@ -750,14 +758,19 @@ static double wall_seconds(void)
 
 /* method = auto: the cheapest adequate back-end for the scene.  Between transitions a
  * Coulomb scene is linear with constant coefficients, so the exact stepper is both exact and
- * the fastest; friction state (rate-and-state: 1/m = 1000, state relaxing at v B / L0) makes
- * the problem stiff; the rest is non-stiff. */
+ * the fastest, up to chains whose slipping stretches get long (its restart cost grows as their
+ * size cubed; measured in bench/); friction state (rate-and-state: 1/m = 1000, state relaxing
+ * at v B / L0) makes the problem stiff; the rest is non-stiff. */
+#define AUTO_EXACT_MAX_BLOCKS 32
+
 static const char *choose_method(const bk_config *config, const bk_scene *scene)
 {
     if (strcmp(config->solver.method, "auto") != 0)
         return config->solver.method;
-    if (scene->affine)
+    if (scene->affine && scene->n <= AUTO_EXACT_MAX_BLOCKS)
         return "exact";
+    if (scene->affine)
+        return "cvode_adams";
     return config->model->n_friction_state > 0 ? "cvode_bdf" : "cvode_adams";
 }
 

@@ -173,7 +173,7 @@ static void test_rejections(void **state)
          "t.ini:1: [modle]: unknown section (allowed: model, block, block.I, friction, friction.I, driver, "
          "solver, output, run; I is a block index from 0)"},
         {"mass = 1\n", "mass = 1\nmas = 2\n",
-         "t.ini:5: [block] mas: unknown key (allowed: mass, driver_stiffness, normal_force, x_init, v_init)"},
+         "t.ini:5: [block] mas: unknown key (allowed: mass, driver_stiffness, normal_force, x_init, v_init, x_init_random)"},
         {"mass = 1\n", "mass = 1\nmass = 2\n", "t.ini:5: [block] mass: duplicate key (first set at line 4)"},
         {"n_blocks = 1\n", "", "t.ini: [model] n_blocks: required key missing (allowed: 1 <= n_blocks <= 1000000, an integer)"},
         {"mass = 1\n", "", "t.ini: [block] mass: required key missing (allowed: 0 < mass < inf kg)"},
