@@ -54,7 +54,7 @@ build-asan/tests/test_%: build-asan/tests/test_%.o $(call objs,build-asan,$(TEST
 
 # Tests run from the repository root (they read configs/ and need ./bksim for CLI tests).
 test: test-plain test-asan
-test-plain: bksim $(TESTS)
+test-plain: bksim build/bench/bksim_bench $(TESTS)
 	@scripts/run_tests.sh build/tests $(TESTS)
 test-asan: bksim $(TESTS_ASAN)
 	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
@@ -69,10 +69,17 @@ test-valgrind: bksim $(TESTS)
 
 # Static analysis; options and suppressions are committed in tests/cppcheck.cfg.
 lint:
-	cppcheck $$(cat tests/cppcheck.cfg) -Iinclude -Isrc src tests/*.c tests/fuzz/*.c
+	cppcheck $$(cat tests/cppcheck.cfg) -Iinclude -Isrc src tests/*.c tests/fuzz/*.c bench/*.c
 
 paper: bksim
 	scripts/run_paper.sh
+
+# The work-precision benchmark (not in CI; a --quick smoke run is part of make test).
+build/bench/bksim_bench: bench/bench.c build/libbksim.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) $(CFLAGS) -o $@ $< build/libbksim.a $(LDLIBS)
+bench: bksim build/bench/bksim_bench
+	scripts/bench.sh
 
 # Fuzz the config loader with libFuzzer (clang): make fuzz FUZZ_SECONDS=600.  The working
 # corpus lives in build-fuzz/; crashers go to build-fuzz/artifacts/ (keep them as

@@ -781,6 +781,34 @@ static void test_restart_errors(void **state)
     free(text);
 }
 
+/* The benchmark's smoke run: every back-end on case B at three tolerances, all succeed and
+ * the error against the exact stepper falls as rtol tightens. */
+static void test_bench_smoke(void **state)
+{
+    (void)state;
+    char *text = NULL;
+    assert_int_equal(run("build/bench/bksim_bench --quick --repeats 1 --case B_coulomb", &text), 0);
+    char method[64] = "", last_method[64] = "";
+    double last_error = 0.0;
+    int rows = 0;
+    for (char *line = strtok(text, "\n"); line; line = strtok(NULL, "\n")) {
+        char name[64], status[16];
+        double rtol, cpu, error_x;
+        if (sscanf(line, "%63s %63s %lf %15s %lf %*d %*d %*d %*d %lf", name, method, &rtol, status, &cpu,
+                   &error_x) != 6 || strcmp(name, "B_coulomb") != 0 || strncmp(method, "reference", 9) == 0)
+            continue;
+        ++rows;
+        assert_string_equal(status, "ok");
+        /* Within one method's sweep the error falls (exact has a single row). */
+        if (strcmp(method, last_method) == 0)
+            assert_true(error_x < last_error);
+        last_error = error_x;
+        snprintf(last_method, sizeof last_method, "%s", method);
+    }
+    free(text);
+    assert_true(rows >= 20);
+}
+
 /* README's config reference is exactly what `bksim keys` prints. */
 static void test_readme_reference_current(void **state)
 {
@@ -821,6 +849,7 @@ int main(void)
         cmocka_unit_test(test_limits),
         cmocka_unit_test(test_restart_equivalence),
         cmocka_unit_test(test_restart_errors),
+        cmocka_unit_test(test_bench_smoke),
         cmocka_unit_test(test_readme_reference_current),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);
