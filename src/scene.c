@@ -289,8 +289,9 @@ int bk_scene_rhs(double t, const double *y, double *ydot, void *user)
     for (size_t k = 0; k < scene->n_stateful; ++k) {
         size_t i = scene->stateful[k];
         const bk_block *b = &model->blocks[i];
-        size_t s = scene->slot[i];
-        double speed = s == NO_SLOT ? 0.0 : fabs(y[s + 1]);
+        /* A stuck block's state ages at rest.  In the full layout its v is 0 by the
+         * constraint anyway, and |v| has no derivative there for the Jacobian. */
+        double speed = bk_scene_stuck(scene, i) ? 0.0 : fabs(y[scene->slot[i] + 1]);
         b->law->state_rate(b->friction_params, speed, &y[scene->state_slot[i]],
                            &ydot[scene->state_slot[i]]);
     }
@@ -363,11 +364,12 @@ int bk_scene_jacobian(double t, const double *y, void *user,
                 put(matrix, s, s + 1, 1.0);
                 put(matrix, s + 1, s + 1, -1.0);
             }
-    /* State equations: d(rate)/d(state) and, while v is in y, d(rate)/dv. */
+    /* State equations: d(rate)/d(state) and, while slipping, d(rate)/dv. */
     for (size_t k = 0; k < scene->n_stateful; ++k) {
         size_t i = scene->stateful[k], q = scene->state_slot[i], s = scene->slot[i];
         const bk_block *b = &model->blocks[i];
-        double v_i = s == NO_SLOT ? 0.0 : y[s + 1], spd = fabs(v_i);
+        int slipping = !bk_scene_stuck(scene, i);
+        double v_i = slipping ? y[s + 1] : 0.0, spd = fabs(v_i);
         double st[BK_FRICTION_MAX_STATE], up[BK_FRICTION_MAX_STATE], down[BK_FRICTION_MAX_STATE];
         double hs = 1e-6 * fmax(fabs(y[q]), 1e-12);
         st[0] = y[q] + hs;
@@ -375,7 +377,7 @@ int bk_scene_jacobian(double t, const double *y, void *user,
         st[0] = y[q] - hs;
         b->law->state_rate(b->friction_params, spd, st, down);
         put(matrix, q, q, (up[0] - down[0]) / (2.0 * hs));
-        if (s != NO_SLOT) {
+        if (slipping) {
             double hv = 1e-6 * fmax(spd, 1e-9);
             b->law->state_rate(b->friction_params, spd + hv, &y[q], up);
             b->law->state_rate(b->friction_params, fmax(spd - hv, 0.0), &y[q], down);
