@@ -75,8 +75,8 @@ typedef struct bk_scene {
 } bk_scene;
 
 int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema);
-/* Block i is stuck in the current layout (modes change only at restarts, except a block
- * that cannot stick, whose slip direction follows its velocity). */
+/* Block i is stuck in the current layout: a mode changes only at an event, which a restart
+ * follows (a block that cannot stick only flips its slip direction). */
 static inline int bk_scene_stuck(const bk_scene *scene, size_t i)
 {
     return scene->mode[i] == BK_MODE_STICK;
