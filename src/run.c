@@ -4,8 +4,9 @@
  *   repeat until t_end:
  *     every block stuck and no friction state: nothing to integrate; find the next breakaway
  *       in closed form (the applied forces are linear in the driver position) and jump;
- *     otherwise: restart the back-end on the compact ODE of the slipping blocks, step, emit
- *       samples by dense output, and at a root let the mode machine decide.
+ *     otherwise: restart the back-end on the compact ODE of the slipping blocks (or the
+ *       full-layout DAE, for a back-end that wants it), step, emit samples by dense output,
+ *       and at a root let the mode machine decide.
  *
  * A slip-rate minimum with s v < 0 means a stop hidden inside one step (velocity dipped
  * through zero and back): the stop is located on the step's interpolant and the run
@@ -27,7 +28,6 @@
 #include "prescribed.h"
 #include "scene.h"
 
-#define NO_SLOT SIZE_MAX
 #define PI 3.14159265358979323846
 
 typedef struct run_ctx {
@@ -394,7 +394,7 @@ static int handle_root(run_ctx *ctx, double t_root, int from_root, double *t_eve
     double t_hidden = t_root;
     size_t hidden_block = SIZE_MAX;
     for (size_t i = 0; i < n; ++i) {
-        if (scene->slot[i] == NO_SLOT || !scene->can_stick[i] || ctx->found[R * i + BK_ROOT_MAIN])
+        if (bk_scene_stuck(scene, i) || !scene->can_stick[i] || ctx->found[R * i + BK_ROOT_MAIN])
             continue;
         if (from_root && !ctx->found[R * i + BK_ROOT_EXTREMUM])
             continue;
@@ -437,8 +437,8 @@ static int handle_root(run_ctx *ctx, double t_root, int from_root, double *t_eve
         int fired = i == hidden_block || (!rewound && ctx->found[R * i + BK_ROOT_MAIN] != 0);
         if (!fired)
             continue;
-        int stuck = scene->slot[i] == NO_SLOT;
-        rc = apply_event(ctx, t, i, stuck ? BK_EVENT_BREAKAWAY : BK_EVENT_STOP);
+        bk_mode_event event = bk_scene_stuck(scene, i) ? BK_EVENT_BREAKAWAY : BK_EVENT_STOP;
+        rc = apply_event(ctx, t, i, event);
         if (rc < 0)
             return rc;
         changed |= rc;
@@ -493,10 +493,11 @@ static int integrate(run_ctx *ctx, double *t)
     bk_scene_restart(scene, *t, ctx->y);
     bk_scene_tolerances(scene, ctx->atol_x, ctx->atol_v, ctx->atol_state, ctx->atol_energy, ctx->atol);
     ctx->problem.half_bandwidth = scene->half_bandwidth;
-    /* Pairs lead the layout only when no friction state is interleaved. */
-    ctx->problem.n_pairs = ctx->model->n_friction_state == 0 ? scene->n_active : 0;
+    /* Pairs lead the layout only when no friction state is interleaved; the full layout's
+     * stuck pairs are no oscillators, so it declares no structure. */
+    ctx->problem.n_pairs = ctx->model->n_friction_state == 0 && !scene->full_layout ? scene->n_active : 0;
     ctx->problem.pair_mass = scene->active_mass;
-    ctx->problem.affine = scene->affine;
+    ctx->problem.affine = scene->affine && !scene->full_layout;
     double t_checkpoint = checkpoint_time(ctx);
     double t_stop = t_checkpoint < ctx->t_end ? t_checkpoint : ctx->t_end;
     int rc = ctx->backend->start(ctx->solver, &ctx->problem, *t, ctx->y, ctx->atol, scene->n_y,
@@ -884,7 +885,9 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
         .roots = bk_scene_roots,
         .n_roots = n * ctx.scene.roots_per_block,
         .root_direction = ctx.scene.root_direction,
+        .differential_id = ctx.backend->wants_full_layout ? ctx.scene.differential_id : NULL,
     };
+    ctx.scene.full_layout = ctx.backend->wants_full_layout;
     if ((rc = ctx.backend->create(&ctx.solver, &ctx.options, err)) != BK_OK) {
         ctx.solver = NULL;
         goto done;

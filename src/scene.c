@@ -1,5 +1,6 @@
-/* The compact ODE of a chain with per-block modes (layout in scene.h): right-hand side,
- * root functions, and packing between the chain's arrays and the integrator's vector.
+/* The compact ODE of a chain with per-block modes, or IDA's full-layout DAE (layouts in
+ * scene.h): right-hand side, root functions, and packing between the chain's arrays and
+ * the integrator's vector.
  *
  * Root functions, per block (all clearly non-zero right after the block switched, so a
  * just-handled root cannot fire again after a restart):
@@ -42,13 +43,14 @@ int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
     scene->state_slot = calloc(n, sizeof *scene->state_slot);
     scene->active = calloc(n, sizeof *scene->active);
     scene->active_mass = calloc(n, sizeof *scene->active_mass);
+    scene->differential_id = calloc(2 * n + model->n_friction_state + 2, sizeof *scene->differential_id);
     scene->stateful = calloc(n, sizeof *scene->stateful);
     scene->left = calloc(n, sizeof *scene->left);
     scene->right = calloc(n, sizeof *scene->right);
     scene->root_direction = calloc(n * scene->roots_per_block, sizeof *scene->root_direction);
     if (!scene->mode || !scene->x_ref || !scene->x || !scene->v || !scene->state ||
         !scene->normal || !scene->t_switch || !scene->from_rest || !scene->taut || !scene->can_stick || !scene->extremum_armed || !scene->slot ||
-        !scene->state_slot || !scene->active || !scene->active_mass || !scene->stateful || !scene->left ||
+        !scene->state_slot || !scene->active || !scene->active_mass || !scene->differential_id || !scene->stateful || !scene->left ||
         !scene->right || !scene->root_direction) {
         bk_scene_free(scene);
         return -1;
@@ -90,6 +92,7 @@ void bk_scene_free(bk_scene *scene)
     free(scene->state_slot);
     free(scene->active);
     free(scene->active_mass);
+    free(scene->differential_id);
     free(scene->stateful);
     free(scene->left);
     free(scene->right);
@@ -159,10 +162,18 @@ void bk_scene_restart(bk_scene *scene, double t, double *y)
             scene->active[scene->n_active++] = i;
             y[next] = 0.0;
             y[next + 1] = scene->v[i];
+            scene->differential_id[next] = scene->differential_id[next + 1] = 1.0;
             next += 2;
         } else {
-            scene->slot[i] = NO_SLOT;
             scene->v[i] = 0.0;
+            scene->slot[i] = scene->full_layout ? next : NO_SLOT;
+            if (scene->full_layout) {
+                /* Consistent as it stands: v = 0 satisfies the constraint, xi' = v = 0. */
+                y[next] = y[next + 1] = 0.0;
+                scene->differential_id[next] = 1.0;
+                scene->differential_id[next + 1] = 0.0;
+                next += 2;
+            }
             if (scene->taut[i]) {
                 scene->stuck_taut_stiffness += b->driver_stiffness;
                 scene->stuck_force_ref += b->driver_stiffness * extension;
@@ -172,6 +183,8 @@ void bk_scene_restart(bk_scene *scene, double t, double *y)
         if (ns > 0) {
             scene->state_slot[i] = next;
             memcpy(&y[next], &scene->state[b->state_offset], ns * sizeof *y);
+            for (size_t j = 0; j < ns; ++j)
+                scene->differential_id[next + j] = 1.0;
             next += ns;
             if (ns > max_state)
                 max_state = ns;
@@ -183,6 +196,7 @@ void bk_scene_restart(bk_scene *scene, double t, double *y)
     }
     y[next] = 0.0;     /* driver work since t */
     y[next + 1] = 0.0; /* dissipation since t */
+    scene->differential_id[next] = scene->differential_id[next + 1] = 1.0;
     scene->n_y = next + 2;
     scene->half_bandwidth = 3 + max_state;
     scene->t_ref = t;
@@ -199,8 +213,10 @@ void bk_scene_restart(bk_scene *scene, double t, double *y)
 void bk_scene_tolerances(const bk_scene *scene, double atol_x, double atol_v, double atol_state,
                          double atol_energy, double *atol)
 {
-    for (size_t k = 0; k < scene->n_active; ++k) {
-        size_t s = scene->slot[scene->active[k]];
+    for (size_t i = 0; i < scene->n; ++i) {
+        size_t s = scene->slot[i];
+        if (s == NO_SLOT)
+            continue;
         atol[s] = atol_x;
         atol[s + 1] = atol_v;
     }
@@ -223,6 +239,7 @@ void bk_scene_unpack(bk_scene *scene, double t, const double *y)
             scene->x[i] = scene->x_ref[i];
             scene->v[i] = 0.0;
         } else {
+            /* In the full layout a stuck block too reports what the integrator holds. */
             scene->x[i] = scene->x_ref[i] + y[s];
             scene->v[i] = y[s + 1];
             /* A block that cannot stick reports the way it moves (its law is odd in v). */
@@ -262,11 +279,19 @@ int bk_scene_rhs(double t, const double *y, double *ydot, void *user)
         driver_force_sum += spring;
         dissipation_rate += dir * friction * v_i;
     }
+    if (scene->full_layout)
+        for (size_t i = 0; i < scene->n; ++i)
+            if (bk_scene_stuck(scene, i)) {
+                size_t s = scene->slot[i];
+                ydot[s] = y[s + 1];       /* xi' = v */
+                ydot[s + 1] = -y[s + 1]; /* 0 = -v, algebraic */
+            }
     for (size_t k = 0; k < scene->n_stateful; ++k) {
         size_t i = scene->stateful[k];
         const bk_block *b = &model->blocks[i];
-        size_t s = scene->slot[i];
-        double speed = s == NO_SLOT ? 0.0 : fabs(y[s + 1]);
+        /* A stuck block's state ages at rest.  In the full layout its v is 0 by the
+         * constraint anyway, and |v| has no derivative there for the Jacobian. */
+        double speed = bk_scene_stuck(scene, i) ? 0.0 : fabs(y[scene->slot[i] + 1]);
         b->law->state_rate(b->friction_params, speed, &y[scene->state_slot[i]],
                            &ydot[scene->state_slot[i]]);
     }
@@ -332,11 +357,19 @@ int bk_scene_jacobian(double t, const double *y, void *user,
         if (state)
             put(matrix, dissipation_row, scene->state_slot[i], dir * v_i * d_state);
     }
+    if (scene->full_layout)
+        for (size_t i = 0; i < scene->n; ++i)
+            if (bk_scene_stuck(scene, i)) {
+                size_t s = scene->slot[i];
+                put(matrix, s, s + 1, 1.0);
+                put(matrix, s + 1, s + 1, -1.0);
+            }
     /* State equations: d(rate)/d(state) and, while slipping, d(rate)/dv. */
     for (size_t k = 0; k < scene->n_stateful; ++k) {
         size_t i = scene->stateful[k], q = scene->state_slot[i], s = scene->slot[i];
         const bk_block *b = &model->blocks[i];
-        double v_i = s == NO_SLOT ? 0.0 : y[s + 1], spd = fabs(v_i);
+        int slipping = !bk_scene_stuck(scene, i);
+        double v_i = slipping ? y[s + 1] : 0.0, spd = fabs(v_i);
         double st[BK_FRICTION_MAX_STATE], up[BK_FRICTION_MAX_STATE], down[BK_FRICTION_MAX_STATE];
         double hs = 1e-6 * fmax(fabs(y[q]), 1e-12);
         st[0] = y[q] + hs;
@@ -344,7 +377,7 @@ int bk_scene_jacobian(double t, const double *y, void *user,
         st[0] = y[q] - hs;
         b->law->state_rate(b->friction_params, spd, st, down);
         put(matrix, q, q, (up[0] - down[0]) / (2.0 * hs));
-        if (s != NO_SLOT) {
+        if (slipping) {
             double hv = 1e-6 * fmax(spd, 1e-9);
             b->law->state_rate(b->friction_params, spd + hv, &y[q], up);
             b->law->state_rate(b->friction_params, fmax(spd - hv, 0.0), &y[q], down);
@@ -371,7 +404,7 @@ int bk_scene_roots(double t, const double *y, double *g, void *user)
         if (!scene->can_stick[i]) {
             gi[BK_ROOT_MAIN] = 1.0; /* smooth through v = 0: nothing to locate */
             gi[BK_ROOT_EXTREMUM] = 1.0;
-        } else if (s == NO_SLOT) {
+        } else if (bk_scene_stuck(scene, i)) {
             gi[BK_ROOT_MAIN] = b->law->static_threshold(b->friction_params, scene->normal[i], state) -
                                fabs(applied);
             gi[BK_ROOT_EXTREMUM] = 1.0;

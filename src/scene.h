@@ -4,7 +4,12 @@
  * in chain order, per block: [xi, v] if slipping (xi = x - x_ref, the slip since the
  * restart, so the integrator's error scales with the slip, not the absolute position),
  * then the block's friction state if its law has any; and last two energy increments since
- * the restart: driver work and frictional dissipation.  Stuck blocks keep x = x_ref, v = 0. */
+ * the restart: driver work and frictional dissipation.  Stuck blocks keep x = x_ref, v = 0.
+ *
+ * The full layout (full_layout set; only for a back-end that asks, IDA) keeps [xi, v] of
+ * stuck blocks too, as rows xi' = v (differential) and 0 = -v (algebraic: the residual
+ * diag(id) y' - f reads v), so the vector's size never changes.  It costs 2 unknowns per
+ * stuck block, so the other back-ends keep the compact ODE: the DAE is IDA's choice. */
 #ifndef BKSIM_SCENE_H
 #define BKSIM_SCENE_H
 
@@ -41,8 +46,9 @@ typedef struct bk_scene {
                                 minimum: it never starts at or hovers around zero (a slip
                                 that starts with zero acceleration, steady sliding). */
 
-    /* Compact layout, rebuilt at every restart. */
-    size_t *slot;            /* per block: index of xi in y, or SIZE_MAX when stuck */
+    /* Layout, rebuilt at every restart. */
+    int full_layout;         /* stuck blocks stay in y (see above); set before the first restart */
+    size_t *slot;            /* per block: index of xi in y, or SIZE_MAX when stuck (compact) */
     size_t *state_slot;      /* per block: index of its first friction state in y */
     size_t n_y;              /* length of y */
     size_t n_active;         /* slipping blocks */
@@ -54,6 +60,7 @@ typedef struct bk_scene {
     double stuck_force_ref;      /* N, their driver-spring forces at t_ref */
     size_t *active;          /* the n_active slipping blocks, chain order */
     double *active_mass;     /* kg, their masses in the same order */
+    double *differential_id; /* n_y: 1 for a differential component, 0 for an algebraic one */
     int affine;              /* the compact ODE is affine in y and t (see bk_ode_problem) */
     size_t *stateful;        /* blocks whose law carries state */
     size_t n_stateful;
@@ -68,6 +75,12 @@ typedef struct bk_scene {
 } bk_scene;
 
 int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema);
+/* Block i is stuck in the current layout: a mode changes only at an event, which a restart
+ * follows (a block that cannot stick only flips its slip direction). */
+static inline int bk_scene_stuck(const bk_scene *scene, size_t i)
+{
+    return scene->mode[i] == BK_MODE_STICK;
+}
 void bk_scene_free(bk_scene *scene);
 
 /* Rebuild the layout for the current modes at time t (x, v, state, work, dissipation hold
@@ -85,7 +98,8 @@ double bk_scene_slip_acceleration(const bk_scene *scene, size_t i, double t, con
 /* Fill x, v, state, work, dissipation from the integrated vector y at time t. */
 void bk_scene_unpack(bk_scene *scene, double t, const double *y);
 
-/* The ODE right-hand side and root functions for the current layout (bk_ode_problem). */
+/* The ODE right-hand side and root functions for the current layout (bk_ode_problem); in
+ * the full layout f of the semi-explicit DAE, a stuck block's velocity row being -v. */
 int bk_scene_rhs(double t, const double *y, double *ydot, void *scene);
 /* The exact Jacobian of bk_scene_rhs (see bk_ode_problem.jacobian); friction-law
  * derivatives by central differences. */

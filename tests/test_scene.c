@@ -1,5 +1,6 @@
 /* The compact ODE: only slipping blocks are integrated, stateless laws carry no state, and
- * every root function of a block that just switched starts clearly away from zero. */
+ * every root function of a block that just switched starts clearly away from zero.  IDA's
+ * full layout: stuck blocks stay in, pinned by an algebraic row whose residual is v. */
 #include <stdint.h>
 #include <stdlib.h>
 
@@ -53,6 +54,66 @@ static void test_layout(void **state)
     assert_close(s.x[1], 2.5e-5, 1e-15, 0);
     assert_close(s.x[0], 0.0, 0, 0);
     bk_scene_free(&s);
+    bk_model_free(m);
+}
+
+/* The full layout keeps a stuck block's (xi, v): xi' = v is differential, the residual
+ * diag(id) y' - f of its velocity row is exactly v with id 0, and the slipping blocks'
+ * rows, energy rates and roots are those of the compact ODE. */
+static void test_full_layout(void **state)
+{
+    (void)state;
+    bk_model *m = make_chain(4, BK_SPRING_LINEAR);
+    bk_scene compact, full;
+    assert_int_equal(bk_scene_init(&compact, m, 1), 0);
+    assert_int_equal(bk_scene_init(&full, m, 1), 0);
+    full.full_layout = 1;
+    bk_scene *both[2] = {&compact, &full};
+    double y[2][16], ydot[2][16], g[2][8], t = 0.3;
+    for (size_t k = 0; k < 2; ++k) {
+        bk_scene *s = both[k];
+        s->x[0] = 1e-4;
+        s->x[2] = -0.5e-4;
+        s->mode[1] = BK_MODE_SLIP_POS;
+        s->mode[3] = BK_MODE_SLIP_NEG;
+        s->v[1] = 0.01;
+        s->v[3] = -0.02;
+        s->v[0] = 0.5; /* a stuck block's velocity is forced to zero */
+        bk_scene_restart(s, t, y[k]);
+    }
+    assert_int_equal(full.n_y, 4 * 2 + 2);
+    assert_int_equal(full.n_active, 2);
+    for (size_t i = 0; i < 4; ++i) {
+        size_t s = full.slot[i];
+        assert_true(s != SIZE_MAX);
+        assert_close(full.differential_id[s], 1.0, 0, 0);
+        assert_close(full.differential_id[s + 1], i % 2 == 0 ? 0.0 : 1.0, 0, 0);
+    }
+    assert_close(full.differential_id[full.n_y - 2], 1.0, 0, 0);
+    assert_close(full.differential_id[full.n_y - 1], 1.0, 0, 0);
+    size_t stuck = full.slot[2];
+    assert_close(y[1][stuck], 0.0, 0, 0);
+    assert_close(y[1][stuck + 1], 0.0, 0, 0);
+    for (size_t k = 0; k < 2; ++k) {
+        bk_scene_rhs(t + 1e-3, y[k], ydot[k], both[k]);
+        bk_scene_roots(t + 1e-3, y[k], g[k], both[k]);
+    }
+    for (size_t i = 1; i < 4; i += 2)
+        for (size_t c = 0; c < 2; ++c)
+            assert_close(ydot[1][full.slot[i] + c], ydot[0][compact.slot[i] + c], 0, 0);
+    for (size_t c = 1; c <= 2; ++c)
+        assert_close(ydot[1][full.n_y - c], ydot[0][compact.n_y - c], 0, 0);
+    for (size_t r = 0; r < 4 * compact.roots_per_block; ++r)
+        assert_close(g[1][r], g[0][r], 0, 0);
+    /* Off the constraint (a Newton iterate), the residual of the velocity row reads v. */
+    y[1][stuck + 1] = 0.25;
+    bk_scene_rhs(t, y[1], ydot[1], &full);
+    double yp_stuck_v = 123.0; /* any: an algebraic row has no y' term */
+    double residual = full.differential_id[stuck + 1] * yp_stuck_v - ydot[1][stuck + 1];
+    assert_close(residual, 0.25, 0, 0);
+    assert_close(ydot[1][stuck], 0.25, 0, 0); /* xi' = v */
+    bk_scene_free(&compact);
+    bk_scene_free(&full);
     bk_model_free(m);
 }
 
@@ -183,10 +244,9 @@ static void put_dense(void *matrix, size_t row, size_t col, double value)
 
 /* The analytic Jacobian matches central differences of the right-hand side, for a chain
  * mixing Coulomb and the paper's rate-and-state law, tension-only springs, a periodic
- * wrap, slipping and stuck blocks. */
-static void test_jacobian(void **state)
+ * wrap, slipping and stuck blocks; in the compact and the full layout. */
+static void check_jacobian(int full_layout)
 {
-    (void)state;
     bk_model *m = make_chain(4, BK_SPRING_TENSION_ONLY);
     m->boundary = BK_BOUNDARY_PERIODIC;
     m->blocks[1].law = &bk_friction_rate_state;
@@ -201,6 +261,7 @@ static void test_jacobian(void **state)
     bk_model_finalize(m);
     bk_scene s;
     assert_int_equal(bk_scene_init(&s, m, 1), 0);
+    s.full_layout = full_layout;
     const double x[4] = {1e-4, -2e-4, 3e-4, 0.5e-4}, v[4] = {3e-3, -2e-3, 0.0, 1e-3};
     const int8_t modes[4] = {BK_MODE_SLIP_POS, BK_MODE_SLIP_NEG, BK_MODE_STICK, BK_MODE_SLIP_POS};
     for (size_t i = 0; i < 4; ++i) {
@@ -234,10 +295,18 @@ static void test_jacobian(void **state)
     bk_model_free(m);
 }
 
+static void test_jacobian(void **state)
+{
+    (void)state;
+    check_jacobian(0);
+    check_jacobian(1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_layout),
+        cmocka_unit_test(test_full_layout),
         cmocka_unit_test(test_rhs),
         cmocka_unit_test(test_roots_clear_of_zero_after_switch),
         cmocka_unit_test(test_minimum_root_arming),

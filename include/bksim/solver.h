@@ -3,7 +3,8 @@
  *
  * The problem handed to a back-end is a smooth ODE y' = f(t, y) of size n with nroots root
  * functions g(t, y); the run loop changes n, f's meaning and the root directions between
- * (re)starts. */
+ * (re)starts.  A back-end that sets wants_full_layout gets a semi-explicit DAE instead (see
+ * differential_id). */
 #ifndef BKSIM_SOLVER_H
 #define BKSIM_SOLVER_H
 
@@ -36,6 +37,12 @@ typedef struct bk_ode_problem {
      * difference quotients. */
     int (*jacobian)(double t, const double *y, void *user,
                     void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix);
+    /* NULL: an ODE.  Otherwise (only for back-ends with wants_full_layout) a semi-explicit
+     * DAE of size n: y_k' = f_k(t, y) where differential_id[k] = 1, and the algebraic
+     * constraint 0 = f_k(t, y) where it is 0, i.e. the residual diag(id) y' - f(t, y) = 0.
+     * The start vector satisfies the constraints, and y' = diag(id) f(t0, y0) is consistent
+     * with it.  jacobian is still d f / dy, algebraic rows included. */
+    const double *differential_id;
 } bk_ode_problem;
 
 typedef struct bk_solver_counters {
@@ -51,6 +58,10 @@ enum {
 typedef struct bk_solver_backend {
     const char *name;  /* value of [solver] method */
     const char *doc;
+    /* Ask the run loop for the full layout: every block in the unknowns, stuck ones pinned
+     * by algebraic rows (bk_ode_problem.differential_id).  Otherwise stuck blocks are
+     * removed and the problem is an ODE. */
+    int wants_full_layout;
     /* Prepare for problems of size n; *mem owns everything. */
     int (*create)(void **mem, const bk_solver_options *options, bk_error *err);
     /* (Re)start at t0 from y0 (size n; may differ from the last start) with per-component
@@ -84,7 +95,7 @@ extern const bk_solver_backend bk_solver_arkode_dp45;
 extern const bk_solver_backend bk_solver_arkode_erk;
 extern const bk_solver_backend bk_solver_arkode_dirk;
 extern const bk_solver_backend bk_solver_arkode_imex;
-/* IDA on the residual y' - f(t, y) (src/solver/ida.c) */
+/* IDA on the full layout, stuck blocks as algebraic rows v = 0 (src/solver/ida.c) */
 extern const bk_solver_backend bk_solver_ida;
 /* GSL odeiv2 with event location by bksim (src/solver/gsl.c) */
 extern const bk_solver_backend bk_solver_gsl_rk8pd;

@@ -1,18 +1,24 @@
-/* IDA back-end: variable-order BDF (orders 1-5) on the implicit form of the run loop's ODE,
- *   F(t, y, y') = y' - f(t, y) = 0,
- * every component differential (IDASetId all 1), started from the consistent y'(t0) =
- * f(t0, y0), so no IDACalcIC is needed.  Newton iteration with a dense or band direct
- * linear solver (difference-quotient iteration matrix dF/dy + c_j dF/dy' = c_j I - df/dy).
+/* IDA back-end: variable-order BDF (orders 1-5) on the residual
+ *   F(t, y, y') = diag(id) y' - f(t, y) = 0,
+ * Newton iteration with a dense or band direct linear solver on the exact iteration matrix
+ * dF/dy + c_j dF/dy' = c_j diag(id) - df/dy.
  *
- * The run loop owns the layout and removes stuck blocks from the state, so the problem
- * IDA sees is the same explicit ODE the other back-ends see; stuck blocks are not posed as
- * algebraic constraints v = 0 here (see README "Solver back-ends" for what that would
- * take).
+ * IDA is the one back-end that can pose a stuck block as what it is, a constraint, so it
+ * asks for the scene's full layout (wants_full_layout): every block keeps (xi, v) in the
+ * unknowns, a stuck block's rows being xi' = v (differential) and v = 0 (algebraic,
+ * IDASetId 0).  The price is 2 unknowns per stuck block; the band stays the neighbours'.
+ * The constraint pins v to 0 inside IDA's own Newton iteration, so a stuck block's slip
+ * stays 0 without the run loop removing it, and the vector keeps its size across
+ * transitions: a restart is an IDAReInit with new ids, never a rebuild.
+ *
+ * Every start is consistent as given: differential rows get y' = f(t0, y0); the only
+ * algebraic rows are stuck blocks' v = 0, which the start vector satisfies with y' = 0.
+ * So no IDACalcIC.  An ODE problem (differential_id NULL, as the solver battery poses) is
+ * the special case id = 1.
  *
  * Root finding and dense output are IDA's own; as with CVODE the state returned at a root
- * is just past the crossing.  A restart of equal size reinitialises, a size change
- * rebuilds.  rhs_evals counts residual evaluations (one f each), those for the
- * difference-quotient Jacobian, and the f(t0, y0) of every start. */
+ * is just past the crossing.  rhs_evals counts residual evaluations (one f each), those for
+ * a difference-quotient Jacobian, and the f(t0, y0) of every start. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -58,7 +64,7 @@ static void capture_message(int error_code, const char *module, const char *func
              function ? function : module, error_code);
 }
 
-/* F = y' - f(t, y); f's return convention (> 0 recoverable, < 0 fatal) is IDA's. */
+/* F = diag(id) y' - f(t, y); f's return convention (> 0 recoverable, < 0 fatal) is IDA's. */
 static int residual(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void *user)
 {
     ida_backend *ida = user;
@@ -66,7 +72,10 @@ static int residual(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void *us
     int rc = ida->problem.rhs(t, N_VGetArrayPointer(y), rr, ida->problem.user);
     if (rc != 0)
         return rc;
-    N_VLinearSum(1.0, yp, -1.0, r, r);
+    const double *ypp = N_VGetArrayPointer(yp), *id = ida->problem.differential_id;
+    size_t n = (size_t)N_VGetLength(r);
+    for (size_t k = 0; k < n; ++k)
+        rr[k] = (id && id[k] == 0.0 ? 0.0 : ypp[k]) - rr[k];
     return 0;
 }
 
@@ -127,7 +136,7 @@ static int fail(ida_backend *ida, bk_error *err, const char *what, int flag)
     return BK_ERR_SOLVER;
 }
 
-/* d(residual)/dy + cj d(residual)/dy' for the residual y' - f(t, y): cj I - J. */
+/* d(residual)/dy + cj d(residual)/dy' for the residual diag(id) y' - f(t, y): cj diag(id) - J. */
 static int jacobian_adapter(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector r,
                             SUNMatrix jac, void *user, N_Vector tmp1, N_Vector tmp2, N_Vector tmp3)
 {
@@ -184,9 +193,6 @@ static int build_objects(ida_backend *ida, size_t n, double t0, const double *y0
         return fail(ida, err, "IDAInit", flag);
     IDASetUserData(ida->ida, ida);
     IDASetNoInactiveRootWarn(ida->ida);
-    N_VConst(1.0, ida->id); /* every component differential */
-    if ((flag = IDASetId(ida->ida, ida->id)) != IDA_SUCCESS)
-        return fail(ida, err, "IDASetId", flag);
     if (use_band(ida, n)) {
         sunindextype bw = (sunindextype)ida->problem.half_bandwidth;
         ida->matrix = SUNBandMatrix(len, bw, bw, ida->ctx);
@@ -219,12 +225,15 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
         ida->yp0 = grown;
         ida->capacity = n;
     }
-    /* The consistent initial derivative. */
+    /* The consistent initial derivative: f, and 0 for the algebraic rows. */
     ida->done.rhs_evals++;
     int rc = problem->rhs(t0, y0, ida->yp0, problem->user);
     if (rc != 0)
         return BK_FAIL(err, BK_ERR_SOLVER,
                        "IDA: the right-hand side failed at the start, t = %.17g s (%d)", t0, rc);
+    for (size_t k = 0; k < n && problem->differential_id; ++k)
+        if (problem->differential_id[k] == 0.0)
+            ida->yp0[k] = 0.0;
     int flag;
     if (ida->ida && ida->n == n) {
         memcpy(N_VGetArrayPointer(ida->y), y0, n * sizeof *y0);
@@ -239,6 +248,12 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
             return rc;
         }
     }
+    if (problem->differential_id)
+        memcpy(N_VGetArrayPointer(ida->id), problem->differential_id, n * sizeof *ida->yp0);
+    else
+        N_VConst(1.0, ida->id);
+    if ((flag = IDASetId(ida->ida, ida->id)) != IDA_SUCCESS)
+        return fail(ida, err, "IDASetId", flag);
     memcpy(N_VGetArrayPointer(ida->atol), atol, n * sizeof *atol);
     if ((flag = IDASVtolerances(ida->ida, ida->options.rtol, ida->atol)) != IDA_SUCCESS)
         return fail(ida, err, "IDASVtolerances", flag);
@@ -328,8 +343,10 @@ static void destroy(void *mem)
 
 const bk_solver_backend bk_solver_ida = {
     .name = "ida",
-    .doc = "IDA variable-order BDF (orders 1-5) on the residual y' - f(t, y), Newton with "
-           "dense/band direct solver: stiff",
+    .doc = "IDA variable-order BDF (orders 1-5) on the DAE with stuck blocks as algebraic "
+           "rows v = 0 (2 extra unknowns per stuck block), Newton with dense/band direct "
+           "solver: stiff",
+    .wants_full_layout = 1,
     .create = create,
     .start = start,
     .step = step,

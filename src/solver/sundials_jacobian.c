@@ -32,8 +32,11 @@ int bk_sundials_jacobian(const bk_ode_problem *problem, double t, const double *
     }
     int rc = problem->jacobian(t, y, problem->user, put_entry, &j);
     if (diagonal != 0.0) {
+        const double *id = problem->differential_id;
         sunindextype n = j.band ? SM_COLUMNS_B(matrix) : SM_COLUMNS_D(matrix);
         for (sunindextype k = 0; k < n; ++k) {
+            if (id && id[k] == 0.0)
+                continue; /* an algebraic row has no y' term */
             if (j.band)
                 SM_ELEMENT_B(matrix, k, k) += diagonal;
             else

@@ -6,9 +6,9 @@
 
 #include "bksim/solver.h"
 
-/* matrix = scale * J + diagonal * I with J = d(ydot)/dy at (t, y); a band matrix keeps only
- * the entries inside its band.  CVODE and ARKODE use (1, 0), IDA (-1, cj).  Returns the
- * problem's jacobian status. */
+/* matrix = scale * J + diagonal * D with J = d(ydot)/dy at (t, y) and D = diag of the
+ * problem's differential_id (I for an ODE); a band matrix keeps only the entries inside its
+ * band.  CVODE and ARKODE use (1, 0), IDA (-1, cj).  Returns the problem's jacobian status. */
 int bk_sundials_jacobian(const bk_ode_problem *problem, double t, const double *y, SUNMatrix matrix,
                          double scale, double diagonal);
 
