@@ -243,7 +243,7 @@ int main(int argc, char **argv)
         {"A_rs", "configs/paper/case_a_rs.ini", 5.0, 1e-3, "cvode_bdf"},
         {"B_rs", "configs/paper/case_b_rs.ini", 5.0, 1e-3, "cvode_bdf"},
         {"C_rs", "configs/paper/case_c_rs.ini", 5.0, 1e-3, "cvode_bdf"},
-        {"chain10", "configs/chains/bk10_coulomb.ini", 2.0, 1e-2, "exact"},
+        {"chain10", "configs/chains/bk10_coulomb.ini", 1.0, 1e-2, "exact"},
         {"chain1000", "configs/chains/bk1000_coulomb.ini", 0.5, 1e-2, "cvode_adams"},
     };
     static const double rtols[] = {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12};

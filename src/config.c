@@ -105,7 +105,7 @@ static const key_def keys[] = {
         "driver position at t = 0 (0: at the relaxed blocks)"),
 
     {"solver", {"method", "", 0, 0, 0, 0,
-                "integrator back-end; auto: exact for Coulomb scenes, cvode_bdf with friction state, else cvode_adams"},
+                "integrator back-end; auto: exact for Coulomb scenes (short chains), else gsl_rk8pd, or cvode_bdf when stiff (README \"Solver back-ends\")"},
      BK_KEY_CHOICE, NULL, method_name, "auto"},
     {"solver", {"linear_solver", "", 0, 0, 0, 0, "linear solver of implicit methods: auto (band for long chains), dense, band"},
      BK_KEY_CHOICE, linear_solver_names, NULL, "auto"},

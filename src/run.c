@@ -25,6 +25,7 @@
 #include <gsl/gsl_roots.h>
 
 #include "bksim/solver.h"
+#include "method_choice.h"
 #include "prescribed.h"
 #include "scene.h"
 
@@ -757,24 +758,6 @@ static double wall_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* method = auto: the cheapest adequate back-end for the scene.  Between transitions a
- * Coulomb scene is linear with constant coefficients, so the exact stepper is both exact and
- * the fastest, up to chains whose slipping stretches get long (its restart cost grows as their
- * size cubed; measured in bench/); friction state (rate-and-state: 1/m = 1000, state relaxing
- * at v B / L0) makes the problem stiff; the rest is non-stiff. */
-#define AUTO_EXACT_MAX_BLOCKS 32
-
-static const char *choose_method(const bk_config *config, const bk_scene *scene)
-{
-    if (strcmp(config->solver.method, "auto") != 0)
-        return config->solver.method;
-    if (scene->affine && scene->n <= AUTO_EXACT_MAX_BLOCKS)
-        return "exact";
-    if (scene->affine)
-        return "cvode_adams";
-    return config->model->n_friction_state > 0 ? "cvode_bdf" : "cvode_adams";
-}
-
 /* The state of a checkpoint, back into the scene (x_ref = x: the run restarts there). */
 static int resume(run_ctx *ctx, const bk_checkpoint *cp)
 {
@@ -850,7 +833,7 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
 
     if (bk_scene_init(&ctx.scene, ctx.model, config->solver.detect_velocity_extrema) != 0)
         return BK_FAIL(err, BK_ERR_NOMEM, "out of memory for %zu blocks", ctx.model->n_blocks);
-    const char *method = choose_method(config, &ctx.scene);
+    const char *method = bk_choose_method(config, &ctx.scene);
     ctx.backend = bk_solver_backend_find(method);
     if (!ctx.backend) {
         bk_scene_free(&ctx.scene);

@@ -24,7 +24,7 @@ enum {
 };
 
 typedef struct bk_solver_options {
-    char method[32];        /* back-end name, e.g. "cvode_adams"; default "cvode_adams" */
+    char method[32];        /* back-end name, e.g. "cvode_adams"; default "auto" */
     char linear_solver[16]; /* "dense" | "band" | "auto" (implicit methods); default "auto" */
     double rtol;            /* relative tolerance; default 1e-8 */
     double atol_x;          /* m; NaN = auto (rtol * 1e-3 * slip length scale) */

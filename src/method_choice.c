@@ -1,0 +1,91 @@
+/* method = auto: the cheapest adequate back-end for the scene, from bench/ measurements.
+ *
+ * A Coulomb scene is linear with constant coefficients between transitions, so the exact
+ * stepper is both exact and the fastest (up to AUTO_EXACT_MAX_BLOCKS blocks).  Otherwise an
+ * explicit Runge-Kutta pair is cheapest unless the problem is stiff.  The stiffness measure
+ * is the fastest decay rate of the linearised problem over its fastest oscillation
+ * frequency, on a probe state (every block sliding at the driver speed, initial friction
+ * state); for the paper's law it scales as 1/L0 (the state relaxes over a slip of L0), 2.3 at
+ * the paper's L0 = 2e-5 m.  CPU of
+ * gsl_rk8pd / cvode_bdf at rtol 1e-8 on cases A, B, C (5 s) as L0 shrinks:
+ *   ratio 2.3: 0.33, 0.23, 0.38;  23: 0.8, 0.56, 0.35;  77: 1.9, 0.92, 0.57;
+ *   230: 3.8, 1.5, 0.81;  2300: 28, 8.6, 3.1
+ * so the switch at STIFF_RATIO = 50 costs at most 1.8x against the better of the two, where
+ * always-BDF costs 4x on the paper's own cases and always-RK 28x on a stiff state. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bksim/driver.h"
+#include "method_choice.h"
+
+#define AUTO_EXACT_MAX_BLOCKS 32
+#define STIFF_RATIO 50.0
+
+typedef struct probe_matrix {
+    const bk_scene *scene;
+    double *diagonal;   /* n_y: d f_r / d y_r */
+    double *omega2;     /* n blocks: -d accel_i / d xi_i, (rad/s)^2 */
+    size_t *velocity_row_block; /* n_y: block whose velocity sits in row r, or SIZE_MAX */
+} probe_matrix;
+
+static void put_entry(void *matrix, size_t row, size_t col, double value)
+{
+    probe_matrix *m = matrix;
+    if (row == col)
+        m->diagonal[row] += value;
+    size_t i = m->velocity_row_block[row];
+    if (i != SIZE_MAX && col == m->scene->slot[i])
+        m->omega2[i] -= value;
+}
+
+double bk_stiffness_ratio(const bk_model *model)
+{
+    bk_scene probe;
+    if (bk_scene_init(&probe, model, 0) != 0)
+        return NAN;
+    size_t n = model->n_blocks, n_max = 2 * n + model->n_friction_state + 2;
+    double *y = calloc(n_max, sizeof *y);
+    double *diagonal = calloc(n_max, sizeof *diagonal);
+    double *omega2 = calloc(n, sizeof *omega2);
+    size_t *velocity_row_block = malloc(n_max * sizeof *velocity_row_block);
+    double ratio = NAN;
+    if (y && diagonal && omega2 && velocity_row_block) {
+        double speed = fabs(bk_driver_velocity(&model->driver, 0.0));
+        for (size_t i = 0; i < n; ++i) {
+            probe.mode[i] = BK_MODE_SLIP_POS;
+            probe.v[i] = speed;
+            probe.taut[i] = 1;
+        }
+        bk_scene_restart(&probe, 0.0, y);
+        for (size_t r = 0; r < n_max; ++r)
+            velocity_row_block[r] = SIZE_MAX;
+        for (size_t i = 0; i < n; ++i)
+            velocity_row_block[probe.slot[i] + 1] = i;
+        probe_matrix m = {&probe, diagonal, omega2, velocity_row_block};
+        if (bk_scene_jacobian(0.0, y, &probe, put_entry, &m) == 0) {
+            double decay = 0.0, omega2_max = 0.0;
+            for (size_t r = 0; r < probe.n_y; ++r)
+                decay = fmax(decay, -diagonal[r]);
+            for (size_t i = 0; i < n; ++i)
+                omega2_max = fmax(omega2_max, omega2[i]);
+            ratio = omega2_max > 0.0 ? decay / sqrt(omega2_max) : (decay > 0.0 ? INFINITY : 0.0);
+        }
+    }
+    free(y);
+    free(diagonal);
+    free(omega2);
+    free(velocity_row_block);
+    bk_scene_free(&probe);
+    return ratio;
+}
+
+const char *bk_choose_method(const bk_config *config, const bk_scene *scene)
+{
+    if (strcmp(config->solver.method, "auto") != 0)
+        return config->solver.method;
+    if (scene->affine && scene->n <= AUTO_EXACT_MAX_BLOCKS)
+        return "exact";
+    double ratio = bk_stiffness_ratio(config->model);
+    return ratio <= STIFF_RATIO ? "gsl_rk8pd" : "cvode_bdf"; /* NaN (no probe): the safe one */
+}
