@@ -27,7 +27,10 @@
  * modal period (and max_step); a sign change is located by GSL's Brent on the exact solution
  * to the last few representable doubles and reported with the state just after the crossing,
  * as CVODE does.  A function exactly zero at the start stays inactive until it moves away
- * from zero (CVODE's convention).
+ * from zero (CVODE's convention).  A long chain has many transitions per sampling step, so a
+ * step with several crossings is first halved toward the earliest, and only that one located:
+ * the problem's root functions cover the whole chain, so each probe costs O(N) however small
+ * the cluster, and the number of probes per transition is what must stay bounded.
  *
  * Why.  It is the accuracy yardstick for the integrators (transition times to ~1e-15
  * relative, including case C's grazing stops that no tolerance-driven integrator resolves)
@@ -43,7 +46,9 @@
  * decompositions are cached by the matrix's exact bytes: a hit returns what GSL would
  * compute, which keeps runs and restarts bit-identical.  K, P and Q come from the problem's
  * exact Jacobian when it has one (O(p) entries, checked against the right-hand side by one
- * combined probe) instead of one right-hand-side probe per component, which is O(p^2). */
+ * combined probe) instead of one right-hand-side probe per component, which is O(p^2).
+ * What stays superlinear is one long stretch slipping together (a uniform chain's
+ * synchronous slide): a cluster of p pairs costs p^3 per restart and p^2 per probe. */
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
@@ -139,6 +144,7 @@ typedef struct exact_backend {
     signed char *sign;          /* last non-zero sign seen; 0 = inactive (zero so far) */
     int *found;
     double *g_hi, *g_try, *root_t;
+    double g_try_time;          /* when g_try was evaluated (NAN: not since the start) */
     gsl_root_fsolver *brent;
 
     bk_solver_counters counters;
@@ -893,6 +899,7 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     eb->n_roots = problem->n_roots;
     eb->t0 = eb->t_now = eb->t_lo = eb->t_hi = t0;
     eb->t_stop = t_stop;
+    eb->g_try_time = NAN;
     eb->n_couplings = 0;
     eb->n_clusters = 0;
     memcpy(eb->y0, y0, n * sizeof *y0);
@@ -925,20 +932,54 @@ static int crossed(const exact_backend *eb, size_t i, double g)
     return eb->direction[i] == 0 || eb->direction[i] == -s;
 }
 
+/* All root functions at t into g_try, unless they are there already. */
+static int roots_at(exact_backend *eb, double t, bk_error *err)
+{
+    if (eb->g_try_time == t)
+        return BK_OK;
+    eb->g_try_time = NAN;
+    int rc = call_roots(eb, t, eb->g_try, err);
+    if (rc == BK_OK)
+        eb->g_try_time = t;
+    return rc;
+}
+
+/* Every probe evaluates all root functions on the whole state, so a locate remembers the
+ * values of its function it has seen: Brent asks again for the bracket's ends. */
+#define ROOT_MEMO 8
+
 typedef struct root_probe {
     exact_backend *eb;
     size_t index;
     bk_error *err;
     int status;
+    size_t seen;                /* values remembered, the last ROOT_MEMO of them in the ring */
+    double seen_t[ROOT_MEMO], seen_g[ROOT_MEMO];
 } root_probe;
+
+static void remember(root_probe *rp, double t, double g)
+{
+    rp->seen_t[rp->seen % ROOT_MEMO] = t;
+    rp->seen_g[rp->seen % ROOT_MEMO] = g;
+    rp->seen++;
+}
 
 static double root_value(double t, void *user)
 {
     root_probe *rp = user;
     if (rp->status != BK_OK)
         return NAN;
-    rp->status = call_roots(rp->eb, t, rp->eb->g_try, rp->err);
-    return rp->status == BK_OK ? rp->eb->g_try[rp->index] : NAN;
+    size_t known = rp->seen < ROOT_MEMO ? rp->seen : ROOT_MEMO;
+    // cppcheck-suppress knownConditionTrueFalse ; seen grows through fn.params across calls
+    for (size_t k = 0; k < known; ++k)
+        if (rp->seen_t[k] == t)
+            return rp->seen_g[k];
+    rp->status = roots_at(rp->eb, t, rp->err);
+    if (rp->status != BK_OK)
+        return NAN;
+    double g = rp->eb->g_try[rp->index];
+    remember(rp, t, g);
+    return g;
 }
 
 /* Locate the crossing of function i in [lo, hi] (its old sign at or before lo, its new sign
@@ -947,13 +988,14 @@ static double root_value(double t, void *user)
 static int locate(exact_backend *eb, size_t i, double lo, double hi, double g_hi, double *t_root,
                   bk_error *err)
 {
-    root_probe rp = {eb, i, err, BK_OK};
+    root_probe rp = {.eb = eb, .index = i, .err = err, .status = BK_OK};
     gsl_function fn = {root_value, &rp};
     int old = eb->sign[i];
     if (g_hi == 0.0 || hi <= lo) {
         *t_root = hi;
         return BK_OK;
     }
+    remember(&rp, hi, g_hi);
     /* lo's value differs from the last sign seen only when it is exactly zero there: the
      * crossing is at lo. */
     double g_lo = root_value(lo, &rp);
@@ -1032,7 +1074,7 @@ static int isolate_first(exact_backend *eb, double *lo, double *hi, bk_error *er
     size_t crossing = count_crossed(eb, eb->g_hi);
     for (int halving = 0; halving < MAX_HALVINGS && crossing > 1; ++halving) {
         double mid = *lo + 0.5 * (*hi - *lo);
-        int rc = call_roots(eb, mid, eb->g_try, err);
+        int rc = roots_at(eb, mid, err);
         if (rc != BK_OK)
             return rc;
         size_t early = count_crossed(eb, eb->g_try);
@@ -1078,7 +1120,7 @@ static int find_roots(exact_backend *eb, double lo, double hi, double *t_root, b
         for (size_t i = 0; i < nr; ++i)
             if (eb->root_t[i] <= first + tol && eb->root_t[i] > t)
                 t = eb->root_t[i];
-        int rc = call_roots(eb, t, eb->g_try, err);
+        int rc = roots_at(eb, t, err);
         if (rc != BK_OK)
             return rc;
         /* A function found crossing later whose sign has already flipped at t crossed more
