@@ -689,6 +689,68 @@ static void test_chains_against_cvode(void **state)
         }
 }
 
+/* A 64-block chain with scattered initial offsets (as the 1000-block config): many short
+ * slipping stretches at once, each an independent cluster of the exact stepper, with blocks
+ * joining and leaving them, and with periodic ends a stretch across the wrap.  Every
+ * transition must match CVODE Adams at rtol 1e-10 (a cluster split that dropped or invented
+ * a coupling would change the motion). */
+static bk_config *long_chain_config(bk_boundary boundary, const char *method, double rtol)
+{
+    scene_spec spec = paper_case(0.5, BK_SPRING_LINEAR, method);
+    spec.n = 64;
+    spec.coupling = 2e4;
+    spec.boundary = boundary;
+    spec.rtol = rtol;
+    spec.t_end = 0.6;
+    spec.interval = 1e-2;
+    bk_config *c = make_config(&spec);
+    unsigned long state = 2385;
+    for (size_t i = 0; i < spec.n; ++i) {
+        state = (state * 6364136223846793005ul + 1442695040888963407ul) & 0xfffffffffffffffful;
+        double uniform = (double)(state >> 11) / 9007199254740992.0; /* [0, 1) */
+        c->model->blocks[i].x_init = 6e-5 * (2.0 * uniform - 1.0);
+    }
+    /* The most loaded blocks at the ends: with periodic ends the first slip straddles the
+     * wrap. */
+    c->model->blocks[0].x_init = c->model->blocks[spec.n - 1].x_init = -6e-5;
+    return c;
+}
+
+static void test_long_chain_clusters(void **state)
+{
+    (void)state;
+    const bk_boundary boundaries[] = {BK_BOUNDARY_FREE, BK_BOUNDARY_PERIODIC};
+    for (size_t b = 0; b < 2; ++b) {
+        bk_config *ce = long_chain_config(boundaries[b], "exact", 1e-10);
+        bk_config *cc = long_chain_config(boundaries[b], "cvode_adams", 1e-10);
+        recorder re = {0}, rc = {0};
+        bk_run_stats se, sc;
+        bk_error err = {0};
+        assert_int_equal(run_config(ce, &re, &se, &err), BK_OK);
+        assert_int_equal(run_config(cc, &rc, &sc, &err), BK_OK);
+        assert_true(re.n_transitions >= 100);
+        assert_int_equal(re.n_transitions, rc.n_transitions);
+        double worst = 0.0;
+        for (size_t k = 0; k < re.n_transitions; ++k) {
+            const bk_transition *a = &re.transitions[k], *c = &rc.transitions[k];
+            assert_int_equal(a->block, c->block);
+            assert_int_equal(a->from, c->from);
+            assert_int_equal(a->to, c->to);
+            worst = fmax(worst, fabs(a->t - c->t));
+        }
+        print_message("64 blocks, %s ends: %zu transitions, times agree with CVODE to %.2g s; CPU "
+                      "exact %.3g s, CVODE %.3g s; energy residual %.2g\n",
+                      b == 0 ? "free" : "periodic", re.n_transitions, worst, se.cpu_time,
+                      sc.cpu_time, se.energy_residual);
+        assert_true(worst <= 1e-8);
+        assert_true(fabs(se.energy_residual) <= 1e-11);
+        recorder_free(&re);
+        recorder_free(&rc);
+        free_config(ce);
+        free_config(cc);
+    }
+}
+
 /* --- speed (reported only) --------------------------------------------------------------- */
 
 static double cpu_time_of(bk_config *c, long *transitions)
@@ -748,6 +810,7 @@ int main(void)
         cmocka_unit_test(test_reversal),
         cmocka_unit_test(test_free_mode),
         cmocka_unit_test(test_chains_against_cvode),
+        cmocka_unit_test(test_long_chain_clusters),
         cmocka_unit_test(test_timing),
     };
     return cmocka_run_group_tests_name("exact", tests, NULL, NULL);

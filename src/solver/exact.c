@@ -6,11 +6,11 @@
  *     xi'' = -K xi + a(t)          p pairs (xi, v = xi'), K = M^-1 (stiffness), constant
  *     q'   = P xi + Q v + r(t)     quadratures (energy increments)
  *
- * with a and r affine in t.  start() probes the right-hand side to read K, P, Q and the
- * affine forcing (measured from the starting state, so that u = xi - xi0 starts at 0),
- * symmetrises S = M^(1/2) K M^(-1/2), and diagonalises S = U diag(w_k^2) U^T (GSL).  In the
- * modal coordinates eta = U^T M^(1/2) u each mode is an undamped oscillator with a ramp
- * force, tau = t - t0:
+ * with a and r affine in t.  start() reads K, P, Q and the affine forcing (measured from the
+ * starting state, so that u = xi - xi0 starts at 0), splits the pairs into clusters (the
+ * connected components of K's coupling), symmetrises each cluster's S = M^(1/2) K M^(-1/2)
+ * and diagonalises it, S = U diag(w_k^2) U^T (GSL).  In the modal coordinates
+ * eta = U^T M^(1/2) u each mode is an undamped oscillator with a ramp force, tau = t - t0:
  *
  *     eta_k'' = -w_k^2 eta_k + g_k + d_k tau,   eta_k(0) = 0,  eta_k'(0) = c_k
  *     eta_k   = c_k phi1 + g_k phi2 + d_k phi3,  eta_k' - c_k = -w_k^2 c_k phi2 + g_k phi1 + d_k phi2
@@ -18,22 +18,40 @@
  * where phi0 = cos(w tau), phi1 = sin(w tau)/w, and phi_{j+1} is the integral of phi_j from 0,
  * so phi2 = (1 - cos)/w^2 = 2 sin^2(w tau / 2)/w^2, phi3 = (tau - phi1)/w^2,
  * phi4 = (tau^2/2 - phi2)/w^2; for w tau < 2 phi3 and phi4 come from their power series,
- * and w = 0 (or w^2 within rounding of zero relative to the largest) gives tau^j / j!.  The
- * quadratures are the integrals of their affine rates along this solution, again sums of
- * phi2..phi4, in closed form.  Every evaluation of y(t) is exact up to rounding and costs
- * O(p^2 + p m); nothing is integrated, so there is no truncation error at all.
+ * and w = 0 (or w^2 within rounding of zero relative to the cluster's largest) gives
+ * tau^j / j!.  The quadratures are the integrals of their affine rates along this solution,
+ * again sums of phi2..phi4, in closed form.  Every evaluation of y(t) is exact up to rounding;
+ * nothing is integrated, so there is no truncation error at all.
  *
  * Root functions are sampled along the exact solution at most every 1/16 of the shortest
  * modal period (and max_step); a sign change is located by GSL's Brent on the exact solution
  * to the last few representable doubles and reported with the state just after the crossing,
  * as CVODE does.  A function exactly zero at the start stays inactive until it moves away
- * from zero (CVODE's convention).
+ * from zero (CVODE's convention).  A long chain has many transitions per sampling step, so a
+ * step with several crossings is first halved toward the earliest, and only that one located:
+ * the problem's root functions cover the whole chain, so each probe costs O(N) however small
+ * the cluster, and the number of probes per transition is what must stay bounded.
  *
  * Why.  It is the accuracy yardstick for the integrators (transition times to ~1e-15
  * relative, including case C's grazing stops that no tolerance-driven integrator resolves)
- * and, with a few dozen root evaluations per slip, the fastest method for Coulomb scenes. */
+ * and, with a few dozen root evaluations per slip, the fastest method for Coulomb scenes.
+ *
+ * Why clusters.  Stuck blocks are fixed, so on a long chain the slipping blocks form many
+ * independent short stretches even when hundreds slip at once.  Decomposing the whole p x p
+ * matrix cost O(p^3) per restart and every root probe O(p^2), which made the stepper slower
+ * than CVODE beyond a few dozen blocks.  Per cluster the decomposition costs sum p_i^3 and
+ * a probe sum p_i^2 + O(p); the eigenvectors are exactly those of the block-diagonal matrix,
+ * so nothing is approximated.  A restart changes one or two clusters and the others keep
+ * their matrices bit for bit (and on a uniform chain, equal stretches share one matrix), so
+ * decompositions are cached by the matrix's exact bytes: a hit returns what GSL would
+ * compute, which keeps runs and restarts bit-identical.  K, P and Q come from the problem's
+ * exact Jacobian when it has one (O(p) entries, checked against the right-hand side by one
+ * combined probe) instead of one right-hand-side probe per component, which is O(p^2).
+ * What stays superlinear is one long stretch slipping together (a uniform chain's
+ * synchronous slide): a cluster of p pairs costs p^3 per restart and p^2 per probe. */
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -47,12 +65,36 @@
 
 #define PI 3.14159265358979323846
 #define SAMPLES_PER_PERIOD 16.0
-/* An eigenvalue of S below this fraction of the largest is rounding: the mode is free. */
+/* An eigenvalue of S below this fraction of its cluster's largest is rounding: the mode is
+ * free. */
 #define ZERO_MODE (128.0 * DBL_EPSILON)
 /* Relative size of a structural entry that must vanish (velocity dependence etc.). */
 #define STRUCTURE_TOL 1e-9
 #define BRENT_MAX_ITER 200
+#define MAX_HALVINGS 16
 #define USE_CVODE "; use cvode_adams or cvode_bdf"
+/* Decomposition cache: direct-mapped slots, and a bound on the doubles all entries hold
+ * (16 MiB); past it the cache starts over.  A chain's distinct cluster matrices number a
+ * few per cluster length, far below either bound. */
+#define CACHE_BITS 12
+#define CACHE_SLOTS ((size_t)1 << CACHE_BITS)
+#define CACHE_BUDGET ((size_t)1 << 21)
+
+/* Stiffness coupling K[row][col] (s^-2) between pairs, one Jacobian entry or probe column;
+ * entries for one (row, col) add up. */
+typedef struct coupling {
+    size_t row, col;
+    double value;
+} coupling;
+
+typedef struct cached_modes {
+    uint64_t hash;
+    size_t size;                /* pairs; 0 = empty slot */
+    double *data;               /* S (size^2, the key), then w^2 (size), then U (size^2) */
+} cached_modes;
+
+/* A problem the Jacobian shows the stepper cannot solve (first offending entry). */
+enum { JACOBIAN_OK, JACOBIAN_NOMEM, JACOBIAN_RANGE, JACOBIAN_VELOCITY, JACOBIAN_QUADRATURE };
 
 typedef struct exact_backend {
     bk_solver_options options;
@@ -66,17 +108,35 @@ typedef struct exact_backend {
     double *arena;
     size_t arena_cap;
     double *y0;                 /* n: the starting state */
-    double *f0, *scratch, *probe, *scale; /* n each: rates at the start, work space */
+    double *f0, *scratch, *probe, *scale, *delta, *predicted; /* n each: rates at the start,
+                                                                 work space */
     double *sqrt_mass;          /* p */
-    double *S, *U, *T;          /* p*p: S, its eigenvectors, T = M^(-1/2) U */
-    double *omega2, *omega;     /* p */
+    double *omega2, *omega;     /* p, by mode (a cluster's modes follow its first's) */
     double *c, *g, *d;          /* p: modal initial velocity, forcing, forcing rate */
     double *eta, *deta, *ieta, *idv; /* p: eta, eta' - c, their integrals */
     double *accel0, *accel_rate;/* p: accelerations at t0 and their time rate */
-    double *P, *Q;              /* m*p: quadrature rates' position and velocity coefficients,
-                                   then (in place) the same in modal coordinates */
+    double *P, *Q;              /* m*p: quadrature rates' position and velocity coefficients */
+    double *P_modal, *Q_modal;  /* m*p: the same in modal coordinates */
     double *qdot0, *q_rate;     /* m: quadrature rates at t0 and their time rate */
+
+    /* Clusters: cluster k holds pairs members[first[k] .. first[k + 1]) in ascending order,
+     * its modes are first[k] .. first[k + 1], its matrices start at offset[k]. */
+    size_t *indices;
+    size_t indices_cap;
+    size_t *members, *first, *offset, *cluster_of, *local, *parent; /* p (+1) each */
+    size_t n_clusters;
+    coupling *couplings;        /* K's entries */
+    size_t n_couplings, couplings_cap;
+    double *matrices;           /* S of each cluster (in place), then T = M^(-1/2) U of each,
+                                   then one cluster's work copy */
+    size_t matrices_cap;
+    double *S, *T, *work;
     gsl_eigen_symmv_workspace *eigen;
+    int jacobian_status;
+    size_t bad_row, bad_col;
+
+    cached_modes *cache;        /* CACHE_SLOTS */
+    size_t cache_doubles;
 
     /* Root functions. */
     size_t roots_cap;
@@ -84,6 +144,7 @@ typedef struct exact_backend {
     signed char *sign;          /* last non-zero sign seen; 0 = inactive (zero so far) */
     int *found;
     double *g_hi, *g_try, *root_t;
+    double g_try_time;          /* when g_try was evaluated (NAN: not since the start) */
     gsl_root_fsolver *brent;
 
     bk_solver_counters counters;
@@ -91,13 +152,12 @@ typedef struct exact_backend {
 
 /* --- the modal basis functions ---------------------------------------------------------- */
 
-/* phi[0..4] at tau for angular frequency w >= 0 (see the header). */
+/* phi[1..4] at tau for angular frequency w >= 0 (see the header; phi0 never enters y). */
 static void basis(double w, double tau, double phi[5])
 {
     double x = w * tau;
     double tau2 = tau * tau;
     if (w == 0.0) {
-        phi[0] = 1.0;
         phi[1] = tau;
         phi[2] = 0.5 * tau2;
         phi[3] = tau2 * tau / 6.0;
@@ -105,7 +165,6 @@ static void basis(double w, double tau, double phi[5])
         return;
     }
     double w2 = w * w, half = sin(0.5 * x);
-    phi[0] = cos(x);
     phi[1] = sin(x) / w;
     phi[2] = 2.0 * half * half / w2;
     if (fabs(x) >= 2.0) {
@@ -125,7 +184,7 @@ static void basis(double w, double tau, double phi[5])
     }
 }
 
-/* The exact state at time t into y (size n). */
+/* The exact state at time t into y (size n): O(p) modes, O(sum p_i^2) back to the pairs. */
 static void exact_state(exact_backend *eb, double t, double *y)
 {
     size_t p = eb->p, m = eb->m;
@@ -139,18 +198,24 @@ static void exact_state(exact_backend *eb, double t, double *y)
         eb->ieta[k] = ck * phi[2] + gk * phi[3] + dk * phi[4];
         eb->idv[k] = (dk - w2 * ck) * phi[3] + gk * phi[2];
     }
-    for (size_t i = 0; i < p; ++i) {
-        const double *Ti = &eb->T[i * p];
-        double u = 0.0, dv = 0.0;
-        for (size_t k = 0; k < p; ++k) {
-            u += Ti[k] * eb->eta[k];
-            dv += Ti[k] * eb->deta[k];
+    for (size_t cl = 0; cl < eb->n_clusters; ++cl) {
+        size_t first = eb->first[cl], size = eb->first[cl + 1] - first;
+        const double *T = &eb->T[eb->offset[cl]];
+        const double *eta = &eb->eta[first], *deta = &eb->deta[first];
+        for (size_t r = 0; r < size; ++r) {
+            const double *Tr = &T[r * size];
+            double u = 0.0, dv = 0.0;
+            for (size_t k = 0; k < size; ++k) {
+                u += Tr[k] * eta[k];
+                dv += Tr[k] * deta[k];
+            }
+            size_t i = eb->members[first + r];
+            y[2 * i] = eb->y0[2 * i] + u;
+            y[2 * i + 1] = eb->y0[2 * i + 1] + dv;
         }
-        y[2 * i] = eb->y0[2 * i] + u;
-        y[2 * i + 1] = eb->y0[2 * i + 1] + dv;
     }
     for (size_t j = 0; j < m; ++j) {
-        const double *Pj = &eb->P[j * p], *Qj = &eb->Q[j * p];
+        const double *Pj = &eb->P_modal[j * p], *Qj = &eb->Q_modal[j * p];
         double sum = 0.0;
         for (size_t k = 0; k < p; ++k)
             sum += Pj[k] * eb->ieta[k] + Qj[k] * eb->idv[k];
@@ -162,7 +227,7 @@ static void exact_state(exact_backend *eb, double t, double *y)
 
 static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roots, bk_error *err)
 {
-    size_t need = 5 * n + 3 * p * p + 12 * p + 2 * m * p + 2 * m + 1;
+    size_t need = 7 * n + 12 * p + 4 * m * p + 2 * m + 1;
     if (need > eb->arena_cap) {
         double *grown = malloc(need * sizeof *grown);
         if (!grown)
@@ -177,9 +242,8 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->scratch = a, a += n;
     eb->probe = a, a += n;
     eb->scale = a, a += n;
-    eb->S = a, a += p * p;
-    eb->U = a, a += p * p;
-    eb->T = a, a += p * p;
+    eb->delta = a, a += n;
+    eb->predicted = a, a += n;
     eb->sqrt_mass = a, a += p;
     eb->omega2 = a, a += p;
     eb->omega = a, a += p;
@@ -194,17 +258,27 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->accel_rate = a, a += p;
     eb->P = a, a += m * p;
     eb->Q = a, a += m * p;
+    eb->P_modal = a, a += m * p;
+    eb->Q_modal = a, a += m * p;
     eb->qdot0 = a, a += m;
     eb->q_rate = a;
 
-    /* GSL documents the workspace for one matrix size: keep it exactly p. */
-    if (p > 1 && (!eb->eigen || eb->eigen->size != p)) {
-        if (eb->eigen)
-            gsl_eigen_symmv_free(eb->eigen);
-        eb->eigen = gsl_eigen_symmv_alloc(p);
-        if (!eb->eigen)
-            return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu modes", p);
+    size_t need_indices = 6 * (p + 1);
+    if (need_indices > eb->indices_cap) {
+        size_t *grown = malloc(need_indices * sizeof *grown);
+        if (!grown)
+            return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu pairs", p);
+        free(eb->indices);
+        eb->indices = grown;
+        eb->indices_cap = need_indices;
     }
+    size_t *ix = eb->indices;
+    eb->members = ix, ix += p + 1;
+    eb->first = ix, ix += p + 1;
+    eb->offset = ix, ix += p + 1;
+    eb->cluster_of = ix, ix += p + 1;
+    eb->local = ix, ix += p + 1;
+    eb->parent = ix;
 
     if (n_roots > eb->roots_cap) {
         free(eb->direction);
@@ -228,6 +302,48 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     return BK_OK;
 }
 
+/* Room for the clusters' S and T (`total` doubles each) and one work copy of `largest`^2. */
+static int reserve_matrices(exact_backend *eb, size_t total, size_t largest, bk_error *err)
+{
+    size_t need = 2 * total + largest * largest + 1;
+    if (need > eb->matrices_cap) {
+        double *grown = malloc(need * sizeof *grown);
+        if (!grown)
+            return BK_FAIL(err, BK_ERR_NOMEM,
+                           "exact stepper: out of memory for the modes of %zu pairs", eb->p);
+        free(eb->matrices);
+        eb->matrices = grown;
+        eb->matrices_cap = need;
+    }
+    eb->S = eb->matrices;
+    eb->T = eb->S + total;
+    eb->work = eb->T + total;
+    return BK_OK;
+}
+
+static int add_coupling(exact_backend *eb, size_t row, size_t col, double value)
+{
+    if (eb->n_couplings == eb->couplings_cap) {
+        size_t cap = eb->couplings_cap ? 2 * eb->couplings_cap : 256;
+        coupling *grown = realloc(eb->couplings, cap * sizeof *grown);
+        if (!grown)
+            return -1;
+        eb->couplings = grown;
+        eb->couplings_cap = cap;
+    }
+    eb->couplings[eb->n_couplings++] = (coupling){row, col, value};
+    return 0;
+}
+
+static void cache_clear(exact_backend *eb)
+{
+    for (size_t s = 0; s < CACHE_SLOTS; ++s) {
+        free(eb->cache[s].data);
+        eb->cache[s] = (cached_modes){0};
+    }
+    eb->cache_doubles = 0;
+}
+
 static int create(void **mem, const bk_solver_options *options, bk_error *err)
 {
     exact_backend *eb = calloc(1, sizeof *eb);
@@ -235,7 +351,11 @@ static int create(void **mem, const bk_solver_options *options, bk_error *err)
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory");
     eb->options = *options;
     eb->brent = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
-    if (!eb->brent) {
+    eb->cache = calloc(CACHE_SLOTS, sizeof *eb->cache);
+    if (!eb->brent || !eb->cache) {
+        if (eb->brent)
+            gsl_root_fsolver_free(eb->brent);
+        free(eb->cache);
         free(eb);
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for the root finder");
     }
@@ -251,7 +371,12 @@ static void destroy(void *mem)
     if (eb->eigen)
         gsl_eigen_symmv_free(eb->eigen);
     gsl_root_fsolver_free(eb->brent);
+    cache_clear(eb);
+    free(eb->cache);
     free(eb->arena);
+    free(eb->indices);
+    free(eb->couplings);
+    free(eb->matrices);
     free(eb->direction);
     free(eb->sign);
     free(eb->found);
@@ -259,7 +384,7 @@ static void destroy(void *mem)
     free(eb);
 }
 
-/* --- start: probe, diagonalise ---------------------------------------------------------- */
+/* --- start: read the matrices, split into clusters, diagonalise -------------------------- */
 
 static int call_rhs(exact_backend *eb, double t, const double *y, double *ydot, bk_error *err)
 {
@@ -307,6 +432,29 @@ static int check_kinematics(const exact_backend *eb, const double *y, const doub
     return BK_OK;
 }
 
+static int rhs_checked(exact_backend *eb, double t, const double *y, double *ydot, bk_error *err)
+{
+    int rc = call_rhs(eb, t, y, ydot, err);
+    return rc != BK_OK ? rc : check_kinematics(eb, y, ydot, err);
+}
+
+static int refuse_velocity(size_t pair, size_t velocity_of, bk_error *err)
+{
+    return BK_FAIL(err, BK_ERR_CONFIG,
+                   "method exact: the acceleration of pair %zu depends on the velocity of pair %zu "
+                   "(velocity-dependent friction or damping); it needs Coulomb friction (constant "
+                   "sliding force, no friction state)" USE_CVODE,
+                   pair, velocity_of);
+}
+
+static int refuse_quadrature(size_t component, size_t quadrature, bk_error *err)
+{
+    return BK_FAIL(err, BK_ERR_CONFIG,
+                   "method exact: component %zu's rate depends on component %zu, which should be a "
+                   "quadrature" USE_CVODE,
+                   component, quadrature);
+}
+
 /* A perturbation of component `k` of y0 that is exactly representable as a difference. */
 static double perturb(exact_backend *eb, size_t k)
 {
@@ -316,32 +464,49 @@ static double perturb(exact_backend *eb, size_t k)
     return bumped - eb->y0[k];
 }
 
-/* Read K, the forcing and the quadrature rates off the right-hand side. */
-static int probe(exact_backend *eb, bk_error *err)
+/* The rates at the start and the forcing's time rate; scale = the size of both. */
+static int probe_forcing(exact_backend *eb, bk_error *err)
+{
+    const double *f0 = eb->f0;
+    size_t n = eb->n, p = eb->p, m = eb->m;
+    double t0 = eb->t0, *f = eb->probe;
+    int rc;
+    if ((rc = rhs_checked(eb, t0, eb->y0, eb->f0, err)) != BK_OK)
+        return rc;
+    for (size_t i = 0; i < p; ++i)
+        eb->accel0[i] = f0[2 * i + 1];
+    for (size_t j = 0; j < m; ++j)
+        eb->qdot0[j] = f0[2 * p + j];
+    double dt = (t0 + (1.0 + fabs(t0))) - t0;
+    if ((rc = rhs_checked(eb, t0 + dt, eb->y0, f, err)) != BK_OK)
+        return rc;
+    for (size_t k = 0; k < n; ++k)
+        eb->scale[k] = fabs(f0[k]) + fabs(f[k] - f0[k]);
+    for (size_t i = 0; i < p; ++i)
+        eb->accel_rate[i] = (f[2 * i + 1] - f0[2 * i + 1]) / dt;
+    for (size_t j = 0; j < m; ++j)
+        eb->q_rate[j] = (f[2 * p + j] - f0[2 * p + j]) / dt;
+    return BK_OK;
+}
+
+/* Without a Jacobian: K, P and Q off the right-hand side, one probe per component (O(p)
+ * probes of O(p) each). */
+static int probe_columns(exact_backend *eb, bk_error *err)
 {
     const double *f0 = eb->f0;
     size_t n = eb->n, p = eb->p, m = eb->m;
     double t0 = eb->t0;
     double *f = eb->probe, *scale = eb->scale;
     int rc;
-    if ((rc = check_kinematics(eb, eb->y0, f0, err)) != BK_OK)
-        return rc;
-    for (size_t k = 0; k < n; ++k)
-        scale[k] = fabs(f0[k]);
-    for (size_t i = 0; i < p; ++i)
-        eb->accel0[i] = f0[2 * i + 1];
-    for (size_t j = 0; j < m; ++j)
-        eb->qdot0[j] = f0[2 * p + j];
-
-    /* Positions: columns of -K (into S, unscaled for now) and of P. */
+    /* Positions: columns of K and of P. */
     for (size_t l = 0; l < p; ++l) {
         double h = perturb(eb, 2 * l);
-        if ((rc = call_rhs(eb, t0, eb->scratch, f, err)) != BK_OK ||
-            (rc = check_kinematics(eb, eb->scratch, f, err)) != BK_OK)
+        if ((rc = rhs_checked(eb, t0, eb->scratch, f, err)) != BK_OK)
             return rc;
         for (size_t i = 0; i < p; ++i) {
             double delta = f[2 * i + 1] - f0[2 * i + 1];
-            eb->S[i * p + l] = -delta / h;
+            if (delta != 0.0 && add_coupling(eb, i, l, -delta / h) != 0)
+                return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for the couplings");
             scale[2 * i + 1] += fabs(delta);
         }
         for (size_t j = 0; j < m; ++j) {
@@ -350,37 +515,14 @@ static int probe(exact_backend *eb, bk_error *err)
             scale[2 * p + j] += fabs(delta);
         }
     }
-    /* Time: the forcing's rate. */
-    double dt = (t0 + (1.0 + fabs(t0))) - t0;
-    memcpy(eb->scratch, eb->y0, n * sizeof *eb->scratch);
-    if ((rc = call_rhs(eb, t0 + dt, eb->scratch, f, err)) != BK_OK ||
-        (rc = check_kinematics(eb, eb->scratch, f, err)) != BK_OK)
-        return rc;
-    for (size_t i = 0; i < p; ++i) {
-        double delta = f[2 * i + 1] - f0[2 * i + 1];
-        eb->accel_rate[i] = delta / dt;
-        scale[2 * i + 1] += fabs(delta);
-    }
-    for (size_t j = 0; j < m; ++j) {
-        double delta = f[2 * p + j] - f0[2 * p + j];
-        eb->q_rate[j] = delta / dt;
-        scale[2 * p + j] += fabs(delta);
-    }
     /* Velocities: accelerations must not depend on them; columns of Q. */
     for (size_t l = 0; l < p; ++l) {
         double h = perturb(eb, 2 * l + 1);
-        if ((rc = call_rhs(eb, t0, eb->scratch, f, err)) != BK_OK ||
-            (rc = check_kinematics(eb, eb->scratch, f, err)) != BK_OK)
+        if ((rc = rhs_checked(eb, t0, eb->scratch, f, err)) != BK_OK)
             return rc;
-        for (size_t i = 0; i < p; ++i) {
-            double delta = f[2 * i + 1] - f0[2 * i + 1];
-            if (fabs(delta) > STRUCTURE_TOL * scale[2 * i + 1])
-                return BK_FAIL(err, BK_ERR_CONFIG,
-                               "method exact: the acceleration of pair %zu depends on the velocity "
-                               "of pair %zu (velocity-dependent friction or damping); it needs "
-                               "Coulomb friction (constant sliding force, no friction state)" USE_CVODE,
-                               i, l);
-        }
+        for (size_t i = 0; i < p; ++i)
+            if (fabs(f[2 * i + 1] - f0[2 * i + 1]) > STRUCTURE_TOL * scale[2 * i + 1])
+                return refuse_velocity(i, l, err);
         for (size_t j = 0; j < m; ++j) {
             double delta = f[2 * p + j] - f0[2 * p + j];
             eb->Q[j * p + l] = delta / h;
@@ -390,103 +532,332 @@ static int probe(exact_backend *eb, bk_error *err)
     /* Quadratures: nothing may depend on them. */
     for (size_t j = 0; j < m; ++j) {
         perturb(eb, 2 * p + j);
-        if ((rc = call_rhs(eb, t0, eb->scratch, f, err)) != BK_OK ||
-            (rc = check_kinematics(eb, eb->scratch, f, err)) != BK_OK)
+        if ((rc = rhs_checked(eb, t0, eb->scratch, f, err)) != BK_OK)
             return rc;
         for (size_t k = 0; k < n; ++k)
             if ((k % 2 == 1 || k >= 2 * p) && fabs(f[k] - f0[k]) > STRUCTURE_TOL * scale[k])
-                return BK_FAIL(err, BK_ERR_CONFIG,
-                               "method exact: component %zu's rate depends on component %zu, "
-                               "which should be a quadrature" USE_CVODE,
-                               k, 2 * p + j);
+                return refuse_quadrature(k, 2 * p + j, err);
     }
     return BK_OK;
 }
 
-/* Symmetrise and diagonalise; fill the modal data and the sampling step. */
+/* The Jacobian's put(): K into couplings, P and Q; position rows are left to the kinematics
+ * check of the verifying probe. */
+static void put_entry(void *matrix, size_t row, size_t col, double value)
+{
+    exact_backend *eb = matrix;
+    size_t p = eb->p;
+    if (eb->jacobian_status != JACOBIAN_OK || value == 0.0)
+        return;
+    int status = JACOBIAN_OK;
+    if (row >= eb->n || col >= eb->n)
+        status = JACOBIAN_RANGE;
+    else if (row < 2 * p && row % 2 == 0)
+        return;
+    else if (col >= 2 * p)
+        status = JACOBIAN_QUADRATURE;
+    else if (row < 2 * p && col % 2 == 1)
+        status = JACOBIAN_VELOCITY;
+    else if (row < 2 * p)
+        status = add_coupling(eb, row / 2, col / 2, -value) == 0 ? JACOBIAN_OK : JACOBIAN_NOMEM;
+    else
+        (col % 2 == 0 ? eb->P : eb->Q)[(row - 2 * p) * p + col / 2] += value;
+    if (status != JACOBIAN_OK) {
+        eb->jacobian_status = status;
+        eb->bad_row = row;
+        eb->bad_col = col;
+    }
+}
+
+/* With a Jacobian: K, P and Q from its entries, then one probe moving every component at
+ * once must give the rates the entries predict (the problem's promise that it is affine and
+ * the Jacobian exact, checked). */
+static int read_jacobian(exact_backend *eb, bk_error *err)
+{
+    const double *f0 = eb->f0;
+    size_t n = eb->n, p = eb->p, m = eb->m;
+    eb->jacobian_status = JACOBIAN_OK;
+    int rc = eb->problem.jacobian(eb->t0, eb->y0, eb->problem.user, put_entry, eb);
+    if (rc != 0)
+        return BK_FAIL(err, BK_ERR_SOLVER, "exact stepper: the Jacobian failed (code %d) at t = %.17g s",
+                       rc, eb->t0);
+    switch (eb->jacobian_status) {
+    case JACOBIAN_NOMEM:
+        return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for the couplings");
+    case JACOBIAN_RANGE:
+        return BK_FAIL(err, BK_ERR_SOLVER, "exact stepper: Jacobian entry (%zu, %zu) outside the %zu "
+                       "components", eb->bad_row, eb->bad_col, n);
+    case JACOBIAN_VELOCITY:
+        return refuse_velocity(eb->bad_row / 2, eb->bad_col / 2, err);
+    case JACOBIAN_QUADRATURE:
+        return refuse_quadrature(eb->bad_row, eb->bad_col, err);
+    default:
+        break;
+    }
+    /* Distinct weights, so that no dependence the entries miss can cancel out. */
+    double *delta = eb->delta, *predicted = eb->predicted, *size = eb->scale;
+    for (size_t k = 0; k < n; ++k) {
+        double bumped = eb->y0[k] + (1.0 + fabs(eb->y0[k])) * (1.0 + 0.25 * (double)(k % 4));
+        eb->scratch[k] = bumped;
+        delta[k] = bumped - eb->y0[k];
+        predicted[k] = f0[k];
+        size[k] = fabs(f0[k]);
+    }
+    for (size_t e = 0; e < eb->n_couplings; ++e) {
+        const coupling *cp = &eb->couplings[e];
+        double change = -cp->value * delta[2 * cp->col];
+        predicted[2 * cp->row + 1] += change;
+        size[2 * cp->row + 1] += fabs(change);
+    }
+    for (size_t j = 0; j < m; ++j)
+        for (size_t l = 0; l < p; ++l) {
+            double change = eb->P[j * p + l] * delta[2 * l] + eb->Q[j * p + l] * delta[2 * l + 1];
+            predicted[2 * p + j] += change;
+            size[2 * p + j] += fabs(eb->P[j * p + l] * delta[2 * l]) +
+                               fabs(eb->Q[j * p + l] * delta[2 * l + 1]);
+        }
+    double *f = eb->probe;
+    if ((rc = rhs_checked(eb, eb->t0, eb->scratch, f, err)) != BK_OK)
+        return rc;
+    for (size_t k = 0; k < n; ++k) {
+        if (k < 2 * p && k % 2 == 0)
+            continue;
+        if (fabs(f[k] - predicted[k]) > STRUCTURE_TOL * (size[k] + fabs(f[k] - f0[k])))
+            return BK_FAIL(err, BK_ERR_CONFIG,
+                           "method exact: the rate of component %zu is not the affine function "
+                           "its Jacobian gives (%.17g vs %.17g)" USE_CVODE,
+                           k, f[k], predicted[k]);
+    }
+    return BK_OK;
+}
+
+static size_t find_set(size_t *parent, size_t i)
+{
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+/* Clusters: connected components of K's couplings (a set's root is its smallest pair), in
+ * the order of their first pairs; each cluster's S assembled densely. */
+static int split_clusters(exact_backend *eb, bk_error *err)
+{
+    size_t p = eb->p, *parent = eb->parent;
+    for (size_t i = 0; i < p; ++i)
+        parent[i] = i;
+    for (size_t e = 0; e < eb->n_couplings; ++e) {
+        size_t a = find_set(parent, eb->couplings[e].row), b = find_set(parent, eb->couplings[e].col);
+        if (a < b)
+            parent[b] = a;
+        else if (b < a)
+            parent[a] = b;
+    }
+    size_t count = 0;
+    for (size_t i = 0; i < p; ++i) {
+        size_t root = find_set(parent, i);
+        if (root == i) {
+            eb->cluster_of[i] = count;
+            eb->first[count++] = 0;
+        } else {
+            eb->cluster_of[i] = eb->cluster_of[root];
+        }
+        eb->first[eb->cluster_of[i]]++;
+    }
+    eb->n_clusters = count;
+    /* Sizes into each cluster's first mode, and matrix offsets. */
+    size_t placed = 0, total = 0, largest = 0;
+    for (size_t k = 0; k < count; ++k) {
+        size_t size = eb->first[k];
+        eb->first[k] = placed;
+        eb->offset[k] = total;
+        placed += size;
+        total += size * size;
+        largest = size > largest ? size : largest;
+    }
+    eb->first[count] = placed;
+    eb->offset[count] = total;
+    for (size_t k = 0; k < count; ++k)
+        parent[k] = eb->first[k]; /* the next free member slot */
+    for (size_t i = 0; i < p; ++i) {
+        size_t k = eb->cluster_of[i];
+        eb->local[i] = parent[k] - eb->first[k];
+        eb->members[parent[k]++] = i;
+    }
+    int rc = reserve_matrices(eb, total, largest, err);
+    if (rc != BK_OK)
+        return rc;
+    memset(eb->S, 0, total * sizeof *eb->S);
+    for (size_t e = 0; e < eb->n_couplings; ++e) {
+        const coupling *cp = &eb->couplings[e];
+        size_t k = eb->cluster_of[cp->row], size = eb->first[k + 1] - eb->first[k];
+        eb->S[eb->offset[k] + eb->local[cp->row] * size + eb->local[cp->col]] += cp->value;
+    }
+    return BK_OK;
+}
+
+static uint64_t hash_matrix(const double *S, size_t count)
+{
+    uint64_t hash = 14695981039346656037u ^ count;
+    for (size_t k = 0; k < count; ++k) {
+        uint64_t bits;
+        memcpy(&bits, &S[k], sizeof bits);
+        hash = (hash ^ bits) * 1099511628211u;
+        hash ^= hash >> 31;
+    }
+    return hash;
+}
+
+/* Eigenvalues and eigenvectors of the symmetric size x size S (kept intact), from the cache
+ * when S was seen before. */
+static int eigen_decompose(exact_backend *eb, const double *S, size_t size, double *lambda,
+                           double *U, bk_error *err)
+{
+    size_t count = size * size;
+    if (size == 1) {
+        lambda[0] = S[0];
+        U[0] = 1.0;
+        return BK_OK;
+    }
+    uint64_t hash = hash_matrix(S, count);
+    cached_modes *slot = &eb->cache[hash >> (64 - CACHE_BITS)];
+    if (slot->size == size && slot->hash == hash && memcmp(slot->data, S, count * sizeof *S) == 0) {
+        memcpy(lambda, slot->data + count, size * sizeof *lambda);
+        memcpy(U, slot->data + count + size, count * sizeof *U);
+        return BK_OK;
+    }
+    /* GSL documents the workspace for one matrix size: keep it exactly this one. */
+    if (!eb->eigen || eb->eigen->size != size) {
+        if (eb->eigen)
+            gsl_eigen_symmv_free(eb->eigen);
+        eb->eigen = gsl_eigen_symmv_alloc(size);
+        if (!eb->eigen)
+            return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu modes", size);
+    }
+    memcpy(eb->work, S, count * sizeof *S);
+    gsl_matrix_view A = gsl_matrix_view_array(eb->work, size, size);
+    gsl_matrix_view V = gsl_matrix_view_array(U, size, size);
+    gsl_vector_view values = gsl_vector_view_array(lambda, size);
+    int rc = gsl_eigen_symmv(&A.matrix, &values.vector, &V.matrix, eb->eigen);
+    if (rc != GSL_SUCCESS)
+        return BK_FAIL(err, BK_ERR_SOLVER, "exact stepper: eigen-decomposition failed: %s",
+                       gsl_strerror(rc));
+    /* Remember it; without memory it is merely not remembered. */
+    size_t entry = 2 * count + size;
+    if (entry > CACHE_BUDGET / 8)
+        return BK_OK;
+    if (eb->cache_doubles + entry > CACHE_BUDGET)
+        cache_clear(eb);
+    double *data = malloc(entry * sizeof *data);
+    if (!data)
+        return BK_OK;
+    if (slot->data) {
+        eb->cache_doubles -= 2 * slot->size * slot->size + slot->size;
+        free(slot->data);
+    }
+    memcpy(data, S, count * sizeof *S);
+    memcpy(data + count, lambda, size * sizeof *lambda);
+    memcpy(data + count + size, U, count * sizeof *U);
+    slot->hash = hash;
+    slot->size = size;
+    slot->data = data;
+    eb->cache_doubles += entry;
+    return BK_OK;
+}
+
+/* Cluster k: symmetrise its S, diagonalise; its modes' frequencies, initial velocities and
+ * forcing, and T = M^(-1/2) U. */
+static int cluster_modes(exact_backend *eb, size_t k, bk_error *err)
+{
+    size_t first = eb->first[k], size = eb->first[k + 1] - first;
+    const size_t *members = &eb->members[first];
+    double *S = &eb->S[eb->offset[k]], *T = &eb->T[eb->offset[k]];
+    double s_max = 0.0;
+    for (size_t r = 0; r < size; ++r)
+        for (size_t q = 0; q < size; ++q) {
+            S[r * size + q] *= eb->sqrt_mass[members[r]] / eb->sqrt_mass[members[q]];
+            s_max = fmax(s_max, fabs(S[r * size + q]));
+        }
+    for (size_t r = 0; r < size; ++r)
+        for (size_t q = r + 1; q < size; ++q) {
+            double a = S[r * size + q], b = S[q * size + r];
+            if (fabs(a - b) > STRUCTURE_TOL * s_max)
+                return BK_FAIL(err, BK_ERR_CONFIG,
+                               "method exact: the stiffness coupling pairs %zu and %zu is not "
+                               "symmetric with the pair masses (%.6g vs %.6g)" USE_CVODE,
+                               members[r], members[q], a, b);
+            S[r * size + q] = S[q * size + r] = 0.5 * (a + b);
+        }
+    double *omega2 = &eb->omega2[first];
+    int rc = eigen_decompose(eb, S, size, omega2, T, err);
+    if (rc != BK_OK)
+        return rc;
+    double lambda_max = 0.0;
+    for (size_t q = 0; q < size; ++q)
+        lambda_max = fmax(lambda_max, fabs(omega2[q]));
+    for (size_t q = 0; q < size; ++q) {
+        double l = omega2[q];
+        if (l < -ZERO_MODE * lambda_max)
+            return BK_FAIL(err, BK_ERR_CONFIG,
+                           "method exact: mode %zu is unstable (negative stiffness eigenvalue %.6g "
+                           "s^-2); only oscillating or free modes are solved exactly" USE_CVODE,
+                           first + q, l);
+        if (l <= ZERO_MODE * lambda_max)
+            l = 0.0;
+        omega2[q] = l;
+        eb->omega[first + q] = sqrt(l);
+    }
+    for (size_t q = 0; q < size; ++q) {
+        double c = 0.0, g = 0.0, d = 0.0;
+        for (size_t r = 0; r < size; ++r) {
+            size_t i = members[r];
+            double u = T[r * size + q] * eb->sqrt_mass[i];
+            c += u * eb->y0[2 * i + 1];
+            g += u * eb->accel0[i];
+            d += u * eb->accel_rate[i];
+        }
+        eb->c[first + q] = c;
+        eb->g[first + q] = g;
+        eb->d[first + q] = d;
+    }
+    for (size_t r = 0; r < size; ++r)
+        for (size_t q = 0; q < size; ++q)
+            T[r * size + q] /= eb->sqrt_mass[members[r]];
+    /* Quadrature coefficients into this cluster's modal coordinates. */
+    for (size_t j = 0; j < eb->m; ++j) {
+        const double *Pj = &eb->P[j * eb->p], *Qj = &eb->Q[j * eb->p];
+        for (size_t q = 0; q < size; ++q) {
+            double pq = 0.0, qq = 0.0;
+            for (size_t r = 0; r < size; ++r) {
+                pq += Pj[members[r]] * T[r * size + q];
+                qq += Qj[members[r]] * T[r * size + q];
+            }
+            eb->P_modal[j * eb->p + first + q] = pq;
+            eb->Q_modal[j * eb->p + first + q] = qq;
+        }
+    }
+    return BK_OK;
+}
+
+/* Every cluster's modes, and the sampling step. */
 static int modes(exact_backend *eb, bk_error *err)
 {
-    size_t p = eb->p, m = eb->m;
-    double s_max = 0.0;
+    size_t p = eb->p;
     for (size_t i = 0; i < p; ++i) {
         double mass = eb->problem.pair_mass[i];
         if (!(mass > 0.0) || !isfinite(mass))
             return BK_FAIL(err, BK_ERR_INVALID, "exact stepper: pair %zu has mass %g", i, mass);
         eb->sqrt_mass[i] = sqrt(mass);
     }
-    for (size_t i = 0; i < p; ++i)
-        for (size_t l = 0; l < p; ++l) {
-            eb->S[i * p + l] *= eb->sqrt_mass[i] / eb->sqrt_mass[l];
-            s_max = fmax(s_max, fabs(eb->S[i * p + l]));
-        }
-    for (size_t i = 0; i < p; ++i)
-        for (size_t l = i + 1; l < p; ++l) {
-            double a = eb->S[i * p + l], b = eb->S[l * p + i];
-            if (fabs(a - b) > STRUCTURE_TOL * s_max)
-                return BK_FAIL(err, BK_ERR_CONFIG,
-                               "method exact: the stiffness coupling pairs %zu and %zu is not "
-                               "symmetric with the pair masses (%.6g vs %.6g)" USE_CVODE,
-                               i, l, a, b);
-            eb->S[i * p + l] = eb->S[l * p + i] = 0.5 * (a + b);
-        }
-    if (p == 1) {
-        eb->omega2[0] = eb->S[0];
-        eb->U[0] = 1.0;
-    } else if (p > 1) {
-        gsl_matrix_view A = gsl_matrix_view_array(eb->S, p, p);
-        gsl_matrix_view V = gsl_matrix_view_array(eb->U, p, p);
-        gsl_vector_view lambda = gsl_vector_view_array(eb->omega2, p);
-        int rc = gsl_eigen_symmv(&A.matrix, &lambda.vector, &V.matrix, eb->eigen);
-        if (rc != GSL_SUCCESS)
-            return BK_FAIL(err, BK_ERR_SOLVER, "exact stepper: eigen-decomposition failed: %s",
-                           gsl_strerror(rc));
-    }
+    int rc = split_clusters(eb, err);
+    for (size_t k = 0; k < eb->n_clusters && rc == BK_OK; ++k)
+        rc = cluster_modes(eb, k, err);
+    if (rc != BK_OK)
+        return rc;
     double lambda_max = 0.0;
     for (size_t k = 0; k < p; ++k)
-        lambda_max = fmax(lambda_max, fabs(eb->omega2[k]));
-    for (size_t k = 0; k < p; ++k) {
-        double l = eb->omega2[k];
-        if (l < -ZERO_MODE * lambda_max)
-            return BK_FAIL(err, BK_ERR_CONFIG,
-                           "method exact: mode %zu is unstable (negative stiffness eigenvalue %.6g "
-                           "s^-2); only oscillating or free modes are solved exactly" USE_CVODE,
-                           k, l);
-        if (l <= ZERO_MODE * lambda_max)
-            l = 0.0;
-        eb->omega2[k] = l;
-        eb->omega[k] = sqrt(l);
-    }
-    /* Modal initial velocity, forcing and forcing rate; T = M^(-1/2) U. */
-    for (size_t k = 0; k < p; ++k) {
-        double c = 0.0, g = 0.0, d = 0.0;
-        for (size_t i = 0; i < p; ++i) {
-            double u = eb->U[i * p + k] * eb->sqrt_mass[i];
-            c += u * eb->y0[2 * i + 1];
-            g += u * eb->accel0[i];
-            d += u * eb->accel_rate[i];
-        }
-        eb->c[k] = c;
-        eb->g[k] = g;
-        eb->d[k] = d;
-    }
-    for (size_t i = 0; i < p; ++i)
-        for (size_t k = 0; k < p; ++k)
-            eb->T[i * p + k] = eb->U[i * p + k] / eb->sqrt_mass[i];
-    /* Quadrature coefficients into modal coordinates, in place (a row at a time). */
-    for (size_t j = 0; j < m; ++j) {
-        double *Pj = &eb->P[j * p], *Qj = &eb->Q[j * p];
-        for (size_t k = 0; k < p; ++k) {
-            double pk = 0.0, qk = 0.0;
-            for (size_t l = 0; l < p; ++l) {
-                pk += Pj[l] * eb->T[l * p + k];
-                qk += Qj[l] * eb->T[l * p + k];
-            }
-            eb->eta[k] = pk;
-            eb->deta[k] = qk;
-        }
-        memcpy(Pj, eb->eta, p * sizeof *Pj);
-        memcpy(Qj, eb->deta, p * sizeof *Qj);
-    }
+        lambda_max = fmax(lambda_max, eb->omega2[k]);
     /* Sampling step: a sixteenth of the shortest period, max_step, else a sixteenth of the
      * span (polynomial motion only). */
     double h = lambda_max > 0.0 ? 2.0 * PI / (SAMPLES_PER_PERIOD * sqrt(lambda_max)) : INFINITY;
@@ -528,9 +899,15 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     eb->n_roots = problem->n_roots;
     eb->t0 = eb->t_now = eb->t_lo = eb->t_hi = t0;
     eb->t_stop = t_stop;
+    eb->g_try_time = NAN;
+    eb->n_couplings = 0;
+    eb->n_clusters = 0;
     memcpy(eb->y0, y0, n * sizeof *y0);
+    memset(eb->P, 0, eb->m * p * sizeof *eb->P);
+    memset(eb->Q, 0, eb->m * p * sizeof *eb->Q);
 
-    if ((rc = call_rhs(eb, t0, eb->y0, eb->f0, err)) != BK_OK || (rc = probe(eb, err)) != BK_OK ||
+    if ((rc = probe_forcing(eb, err)) != BK_OK ||
+        (rc = problem->jacobian ? read_jacobian(eb, err) : probe_columns(eb, err)) != BK_OK ||
         (rc = modes(eb, err)) != BK_OK)
         return rc;
 
@@ -555,20 +932,54 @@ static int crossed(const exact_backend *eb, size_t i, double g)
     return eb->direction[i] == 0 || eb->direction[i] == -s;
 }
 
+/* All root functions at t into g_try, unless they are there already. */
+static int roots_at(exact_backend *eb, double t, bk_error *err)
+{
+    if (eb->g_try_time == t)
+        return BK_OK;
+    eb->g_try_time = NAN;
+    int rc = call_roots(eb, t, eb->g_try, err);
+    if (rc == BK_OK)
+        eb->g_try_time = t;
+    return rc;
+}
+
+/* Every probe evaluates all root functions on the whole state, so a locate remembers the
+ * values of its function it has seen: Brent asks again for the bracket's ends. */
+#define ROOT_MEMO 8
+
 typedef struct root_probe {
     exact_backend *eb;
     size_t index;
     bk_error *err;
     int status;
+    size_t seen;                /* values remembered, the last ROOT_MEMO of them in the ring */
+    double seen_t[ROOT_MEMO], seen_g[ROOT_MEMO];
 } root_probe;
+
+static void remember(root_probe *rp, double t, double g)
+{
+    rp->seen_t[rp->seen % ROOT_MEMO] = t;
+    rp->seen_g[rp->seen % ROOT_MEMO] = g;
+    rp->seen++;
+}
 
 static double root_value(double t, void *user)
 {
     root_probe *rp = user;
     if (rp->status != BK_OK)
         return NAN;
-    rp->status = call_roots(rp->eb, t, rp->eb->g_try, rp->err);
-    return rp->status == BK_OK ? rp->eb->g_try[rp->index] : NAN;
+    size_t known = rp->seen < ROOT_MEMO ? rp->seen : ROOT_MEMO;
+    // cppcheck-suppress knownConditionTrueFalse ; seen grows through fn.params across calls
+    for (size_t k = 0; k < known; ++k)
+        if (rp->seen_t[k] == t)
+            return rp->seen_g[k];
+    rp->status = roots_at(rp->eb, t, rp->err);
+    if (rp->status != BK_OK)
+        return NAN;
+    double g = rp->eb->g_try[rp->index];
+    remember(rp, t, g);
+    return g;
 }
 
 /* Locate the crossing of function i in [lo, hi] (its old sign at or before lo, its new sign
@@ -577,13 +988,14 @@ static double root_value(double t, void *user)
 static int locate(exact_backend *eb, size_t i, double lo, double hi, double g_hi, double *t_root,
                   bk_error *err)
 {
-    root_probe rp = {eb, i, err, BK_OK};
+    root_probe rp = {.eb = eb, .index = i, .err = err, .status = BK_OK};
     gsl_function fn = {root_value, &rp};
     int old = eb->sign[i];
     if (g_hi == 0.0 || hi <= lo) {
         *t_root = hi;
         return BK_OK;
     }
+    remember(&rp, hi, g_hi);
     /* lo's value differs from the last sign seen only when it is exactly zero there: the
      * crossing is at lo. */
     double g_lo = root_value(lo, &rp);
@@ -644,6 +1056,42 @@ static void update_signs(exact_backend *eb, const double *g)
             eb->sign[i] = (signed char)(g[i] > 0.0 ? 1 : -1);
 }
 
+static size_t count_crossed(const exact_backend *eb, const double *g)
+{
+    size_t count = 0;
+    for (size_t i = 0; i < eb->n_roots; ++i)
+        count += (size_t)crossed(eb, i, g[i]);
+    return count;
+}
+
+/* On a long chain many functions cross within one sampling step, and locating each to the
+ * last double (a few dozen probes) only to report the first made the cost per transition
+ * grow with the chain.  Halve (lo, hi] (values g_hi at hi) toward the earliest crossing
+ * until one function crosses in it, each halving one probe; crossings closer than
+ * h / 2^MAX_HALVINGS (simultaneous ones) are left to find_roots. */
+static int isolate_first(exact_backend *eb, double *lo, double *hi, bk_error *err)
+{
+    size_t crossing = count_crossed(eb, eb->g_hi);
+    for (int halving = 0; halving < MAX_HALVINGS && crossing > 1; ++halving) {
+        double mid = *lo + 0.5 * (*hi - *lo);
+        int rc = roots_at(eb, mid, err);
+        if (rc != BK_OK)
+            return rc;
+        size_t early = count_crossed(eb, eb->g_try);
+        if (early > 0) {
+            *hi = mid;
+            memcpy(eb->g_hi, eb->g_try, eb->n_roots * sizeof *eb->g_hi);
+            crossing = early;
+        } else {
+            /* Nothing listened to crossed by mid: the signs there are the new reference. */
+            update_signs(eb, eb->g_try);
+            *lo = mid;
+            crossing = count_crossed(eb, eb->g_hi);
+        }
+    }
+    return BK_OK;
+}
+
 /* Look for crossings in (lo, hi] (values g at hi).  Returns 1 with *t_root and found[] when
  * some function crossed, 0 when none did, < 0 on failure. */
 static int find_roots(exact_backend *eb, double lo, double hi, double *t_root, bk_error *err)
@@ -672,7 +1120,7 @@ static int find_roots(exact_backend *eb, double lo, double hi, double *t_root, b
         for (size_t i = 0; i < nr; ++i)
             if (eb->root_t[i] <= first + tol && eb->root_t[i] > t)
                 t = eb->root_t[i];
-        int rc = call_roots(eb, t, eb->g_try, err);
+        int rc = roots_at(eb, t, err);
         if (rc != BK_OK)
             return rc;
         /* A function found crossing later whose sign has already flipped at t crossed more
@@ -718,8 +1166,11 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
     int rc = call_roots(eb, hi, eb->g_hi, err);
     if (rc != BK_OK)
         return rc;
+    double from = lo;
+    if (eb->n_roots > 0 && (rc = isolate_first(eb, &from, &hi, err)) != BK_OK)
+        return rc;
     double t_root = hi;
-    int status = eb->n_roots > 0 ? find_roots(eb, lo, hi, &t_root, err) : 0;
+    int status = eb->n_roots > 0 ? find_roots(eb, from, hi, &t_root, err) : 0;
     if (status < 0)
         return status;
     eb->t_lo = lo;
