@@ -59,7 +59,7 @@ GP
 done
 
 # CPU per transition vs chain length, with a slope-1 guide.
-for m in cvode_adams cvode_bdf exact; do
+for m in cvode_adams cvode_bdf gsl_rk8pd exact; do
     awk -F'\t' -v m="$m" 'NR > 1 && $2 == m && $3 == "ok" {print $1, $6}' "$out/scaling.tsv" > "$out/scaling_$m.dat"
 done
 gnuplot <<GP
@@ -74,6 +74,7 @@ set key top left
 f(x) = 1e-6 * x
 plot '$out/scaling_cvode_adams.dat' using 1:2 with linespoints lw 2 pt 7 title 'cvode_adams', \
      '$out/scaling_cvode_bdf.dat' using 1:2 with linespoints lw 2 pt 5 title 'cvode_bdf (band)', \
+     '$out/scaling_gsl_rk8pd.dat' using 1:2 with linespoints lw 2 pt 11 title 'gsl_rk8pd', \
      '$out/scaling_exact.dat' using 1:2 with linespoints lw 2 pt 9 title 'exact', \
      f(x) with lines dt 2 lc rgb '#777777' title 'slope 1 (linear in N)'
 GP

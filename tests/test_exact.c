@@ -751,48 +751,6 @@ static void test_long_chain_clusters(void **state)
     }
 }
 
-/* --- speed (reported only) --------------------------------------------------------------- */
-
-static double cpu_time_of(bk_config *c, long *transitions)
-{
-    recorder r = {0};
-    bk_run_stats stats;
-    bk_error err = {0};
-    assert_int_equal(run_config(c, &r, &stats, &err), BK_OK);
-    *transitions = (long)r.n_transitions;
-    recorder_free(&r);
-    return stats.cpu_time;
-}
-
-static void test_timing(void **state)
-{
-    (void)state;
-    for (int which = 0; which < 2; ++which) {
-        double t_exact = 0.0, t_cvode = 0.0;
-        long n_exact = 0, n_cvode = 0;
-        for (int rep = 0; rep < 3; ++rep) {
-            bk_config *ce, *cc;
-            if (which == 0) {
-                scene_spec a = paper_case(0.5, BK_SPRING_LINEAR, "exact");
-                scene_spec b = paper_case(0.5, BK_SPRING_LINEAR, "cvode_adams");
-                ce = make_config(&a);
-                cc = make_config(&b);
-            } else {
-                ce = chain_config(BK_SPRING_LINEAR, BK_BOUNDARY_FREE, "exact", 1e-10, 1.0);
-                cc = chain_config(BK_SPRING_LINEAR, BK_BOUNDARY_FREE, "cvode_adams", 1e-10, 1.0);
-            }
-            t_exact += cpu_time_of(ce, &n_exact);
-            t_cvode += cpu_time_of(cc, &n_cvode);
-            free_config(ce);
-            free_config(cc);
-        }
-        print_message("%s: exact %.3g s, cvode_adams (rtol 1e-10) %.3g s CPU per run, ratio "
-                      "cvode/exact %.2g (%ld / %ld transitions)\n",
-                      which == 0 ? "case B, 5 s" : "10-block chain, 1 s", t_exact / 3.0,
-                      t_cvode / 3.0, t_exact > 0.0 ? t_cvode / t_exact : INFINITY, n_exact, n_cvode);
-    }
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -811,7 +769,6 @@ int main(void)
         cmocka_unit_test(test_free_mode),
         cmocka_unit_test(test_chains_against_cvode),
         cmocka_unit_test(test_long_chain_clusters),
-        cmocka_unit_test(test_timing),
     };
     return cmocka_run_group_tests_name("exact", tests, NULL, NULL);
 }
