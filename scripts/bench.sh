@@ -2,33 +2,38 @@
 # The work-precision benchmark (make bench): every back-end x every rtol on the paper's cases
 # and on Coulomb chains, plus CPU per transition against chain length.  Writes, under bench/:
 #   results.tsv, scaling.tsv, machine.txt, wp_<case>.png (error vs CPU, log-log), scaling.png
-# Takes tens of minutes; `scripts/bench.sh --quick` is a smoke run into a temporary directory.
+# Takes a few minutes (4 on the machine in bench/machine.txt); `scripts/bench.sh --quick` is a
+# smoke run into a temporary directory, `--plot-only` redraws the PNGs from the TSVs in bench/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bench=build/bench/bksim_bench
 out=bench
 quick=()
-if [ "${1:-}" = "--quick" ]; then
-    quick=(--quick --repeats 1)
-    out=$(mktemp -d)
-fi
+plot_only=0
+case "${1:-}" in
+    --quick) quick=(--quick --repeats 1); out=$(mktemp -d) ;;
+    --plot-only) plot_only=1 ;;
+esac
 mkdir -p "$out"
 
-{
-    echo "date: $(date -u +%Y-%m-%dT%H:%MZ)"
-    echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')"
-    echo "cores: $(nproc)"
-    echo "os: $(. /etc/os-release && echo "$PRETTY_NAME")"
-    echo "compiler: $(${CC:-cc} --version | head -1)"
-    echo "sundials: $(grep -m1 SUNDIALS_VERSION /usr/include/sundials/sundials_config.h | cut -d'"' -f2)"
-    echo "gsl: $(pkg-config --modversion gsl)"
-    echo "bksim: $(./bksim --version)"
-} > "$out/machine.txt"
+if [ $plot_only = 0 ]; then
+    {
+        echo "date: $(date -u +%Y-%m-%dT%H:%MZ)"
+        echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')"
+        echo "cores: $(nproc)"
+        echo "os: $(. /etc/os-release && echo "$PRETTY_NAME")"
+        echo "compiler: $(${CC:-cc} --version | head -1)"
+        echo "sundials: $(grep -m1 SUNDIALS_VERSION /usr/include/sundials/sundials_config.h | cut -d'"' -f2)"
+        echo "gsl: $(pkg-config --modversion gsl)"
+        echo "bksim: $(./bksim --version)"
+    } > "$out/machine.txt"
 
-"$bench" "${quick[@]}" --out "$out/results.tsv"
-"$bench" --scaling "${quick[@]}" --out "$out/scaling.tsv"
+    "$bench" "${quick[@]}" --out "$out/results.tsv"
+    "$bench" --scaling "${quick[@]}" --out "$out/scaling.tsv"
+fi
 
-# Error vs CPU per case, one curve per back-end (a horizontal cross for the exact stepper).
+# Error vs CPU per case, one curve per back-end; the exact stepper, being the Coulomb
+# reference (error 0), is a vertical line at its CPU time.
 for case in $(awk -F'\t' 'NR > 1 {print $1}' "$out/results.tsv" | sort -u); do
     awk -F'\t' -v c="$case" 'NR > 1 && $1 == c && $4 == "ok" && $2 !~ /^reference/ && $10 != "nan" && $10 > 0 {
             print $2, $5, $10 > "'"$out"'/wp_" c "_" $2 ".dat" }' "$out/results.tsv"
@@ -42,6 +47,12 @@ for case in $(awk -F'\t' 'NR > 1 {print $1}' "$out/results.tsv" | sort -u); do
         k=$((k + 1))
     done
     [ -n "$plots" ] || continue
+    exact_cpu=$(awk -F'\t' -v c="$case" '$1 == c && $2 == "exact" && $4 == "ok" {print $5}' "$out/results.tsv")
+    exact_marker=""
+    if [ -n "$exact_cpu" ]; then
+        exact_marker="set arrow from $exact_cpu, graph 0 to $exact_cpu, graph 1 nohead dt 2 lw 2 lc rgb 'black'
+            set label 'exact stepper (the reference, error 0)' at $exact_cpu, graph 0.03 left offset 0.5, 0"
+    fi
     gnuplot <<GP
 set terminal pngcairo size 1200,800 font 'Sans,12' noenhanced
 set output '$out/wp_$case.png'
@@ -53,6 +64,7 @@ set xlabel 'CPU time per run [s] (median of repeats)'
 set ylabel 'max |x - x_ref| [m]'
 set grid
 set key outside right
+$exact_marker
 plot $plots
 GP
     rm -f "$out"/wp_"$case"_*.dat
@@ -69,6 +81,7 @@ set title 'CPU time per transition vs chain length (Coulomb chain, rtol 1e-8, 0.
 set logscale xy
 set xlabel 'blocks N'
 set ylabel 'CPU time per transition [s]'
+set format y '1e%L'
 set grid
 set key top left
 f(x) = 1e-6 * x

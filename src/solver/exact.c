@@ -72,7 +72,7 @@
 #define STRUCTURE_TOL 1e-9
 #define BRENT_MAX_ITER 200
 #define MAX_HALVINGS 16
-#define USE_CVODE "; use cvode_adams or cvode_bdf"
+#define USE_INTEGRATOR "; use method = auto (it picks an integrator for such scenes), gsl_rk8pd or cvode_bdf"
 /* Decomposition cache: direct-mapped slots, and a bound on the doubles all entries hold
  * (16 MiB); past it the cache starts over.  A chain's distinct cluster matrices number a
  * few per cluster length, far below either bound. */
@@ -426,7 +426,7 @@ static int check_kinematics(const exact_backend *eb, const double *y, const doub
         if (fabs(ydot[2 * i] - v) > 8.0 * DBL_EPSILON * fabs(v))
             return BK_FAIL(err, BK_ERR_CONFIG,
                            "method exact: the rate of position %zu is not its velocity; the state "
-                           "must be (position, velocity) pairs followed by quadratures" USE_CVODE,
+                           "must be (position, velocity) pairs followed by quadratures" USE_INTEGRATOR,
                            i);
     }
     return BK_OK;
@@ -443,7 +443,7 @@ static int refuse_velocity(size_t pair, size_t velocity_of, bk_error *err)
     return BK_FAIL(err, BK_ERR_CONFIG,
                    "method exact: the acceleration of pair %zu depends on the velocity of pair %zu "
                    "(velocity-dependent friction or damping); it needs Coulomb friction (constant "
-                   "sliding force, no friction state)" USE_CVODE,
+                   "sliding force, no friction state)" USE_INTEGRATOR,
                    pair, velocity_of);
 }
 
@@ -451,7 +451,7 @@ static int refuse_quadrature(size_t component, size_t quadrature, bk_error *err)
 {
     return BK_FAIL(err, BK_ERR_CONFIG,
                    "method exact: component %zu's rate depends on component %zu, which should be a "
-                   "quadrature" USE_CVODE,
+                   "quadrature" USE_INTEGRATOR,
                    component, quadrature);
 }
 
@@ -625,7 +625,7 @@ static int read_jacobian(exact_backend *eb, bk_error *err)
         if (fabs(f[k] - predicted[k]) > STRUCTURE_TOL * (size[k] + fabs(f[k] - f0[k])))
             return BK_FAIL(err, BK_ERR_CONFIG,
                            "method exact: the rate of component %zu is not the affine function "
-                           "its Jacobian gives (%.17g vs %.17g)" USE_CVODE,
+                           "its Jacobian gives (%.17g vs %.17g)" USE_INTEGRATOR,
                            k, f[k], predicted[k]);
     }
     return BK_OK;
@@ -785,7 +785,7 @@ static int cluster_modes(exact_backend *eb, size_t k, bk_error *err)
             if (fabs(a - b) > STRUCTURE_TOL * s_max)
                 return BK_FAIL(err, BK_ERR_CONFIG,
                                "method exact: the stiffness coupling pairs %zu and %zu is not "
-                               "symmetric with the pair masses (%.6g vs %.6g)" USE_CVODE,
+                               "symmetric with the pair masses (%.6g vs %.6g)" USE_INTEGRATOR,
                                members[r], members[q], a, b);
             S[r * size + q] = S[q * size + r] = 0.5 * (a + b);
         }
@@ -801,7 +801,7 @@ static int cluster_modes(exact_backend *eb, size_t k, bk_error *err)
         if (l < -ZERO_MODE * lambda_max)
             return BK_FAIL(err, BK_ERR_CONFIG,
                            "method exact: mode %zu is unstable (negative stiffness eigenvalue %.6g "
-                           "s^-2); only oscillating or free modes are solved exactly" USE_CVODE,
+                           "s^-2); only oscillating or free modes are solved exactly" USE_INTEGRATOR,
                            first + q, l);
         if (l <= ZERO_MODE * lambda_max)
             l = 0.0;
@@ -881,12 +881,12 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     if (!problem->affine)
         return BK_FAIL(err, BK_ERR_CONFIG,
                        "method exact needs Coulomb friction (constant sliding force, no friction "
-                       "state)" USE_CVODE);
+                       "state)" USE_INTEGRATOR);
     size_t p = problem->n_pairs;
     if (2 * p > n || (p > 0 && !problem->pair_mass))
         return BK_FAIL(err, BK_ERR_CONFIG,
                        "method exact needs the state as (position, velocity) pairs followed only "
-                       "by quadratures (n = %zu, n_pairs = %zu)" USE_CVODE,
+                       "by quadratures (n = %zu, n_pairs = %zu)" USE_INTEGRATOR,
                        n, p);
     if (!isfinite(t0) || !(t_stop >= t0))
         return BK_FAIL(err, BK_ERR_INVALID, "exact stepper: bad interval [%.17g, %.17g] s", t0, t_stop);
