@@ -36,6 +36,8 @@ build-asan/libbksim.a: $(call objs,build-asan,$(LIB_SRC))
 
 bksim: $(call objs,build,$(CLI_SRC)) build/libbksim.a
 	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
+build-asan/bksim: $(call objs,build-asan,$(CLI_SRC)) build-asan/libbksim.a
+	$(CC) $(CFLAGS) $(SAN) -o $@ $^ $(LDLIBS)
 
 build/%.o: %.c
 	@mkdir -p $(dir $@)
@@ -56,15 +58,16 @@ build-asan/tests/test_%: build-asan/tests/test_%.o $(call objs,build-asan,$(TEST
 test: test-plain test-asan
 test-plain: bksim build/bench/bksim_bench $(TESTS)
 	@scripts/run_tests.sh build/tests $(TESTS)
-test-asan: bksim $(TESTS_ASAN)
-	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+# The CLI tests run the sanitizer build of bksim too (BKSIM, relative to the repository root).
+test-asan: build-asan/bksim build/bench/bksim_bench $(TESTS_ASAN)
+	@BKSIM=build-asan/bksim BK_TEST_TIME_SCALE=10 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
 	 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
 	 scripts/run_tests.sh build-asan/tests $(TESTS_ASAN)
 
 # The whole suite under valgrind memcheck (CI runs it once): no leaks, no invalid access.
 test-valgrind: bksim $(TESTS)
-	@VALGRIND="valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible --show-leak-kinds=definite,indirect,possible" \
+	@BK_TEST_TIME_SCALE=200 VALGRIND="valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible --show-leak-kinds=definite,indirect,possible" \
 	 scripts/run_tests.sh valgrind $(TESTS)
 
 # Static analysis; options and suppressions are committed in tests/cppcheck.cfg.

@@ -396,7 +396,7 @@ static void format_allowed(const key_def *def, const bk_param *param, char *buf,
 
 static int parse_number(const char *text, double *out)
 {
-    if (!*text)
+    if (!*text || strpbrk(text, "xX")) /* decimal only: strtod would take hex floats too */
         return -1;
     char *end = NULL;
     errno = 0;
@@ -757,11 +757,23 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
         int bad = law->validate(b->friction_params, msg, sizeof msg);
         if (bad >= 0) {
             entry *at = origin[bad];
+            /* A conflict with this block's own value is reported at the shared key: name the
+             * block and where its value came from. */
+            char block_note[640] = "";
+            for (size_t q = 0; q < law->n_params && (!at || strcmp(at->section, section) != 0); ++q)
+                if (origin[q] && strcmp(origin[q]->section, section) == 0) {
+                    char where[512];
+                    location(ld, origin[q], where, sizeof where);
+                    if (snprintf(block_note, sizeof block_note, " (block %zu: %s sets [%s] %s = %s)", i,
+                                 where, section, origin[q]->key, origin[q]->value) < 0)
+                        block_note[0] = '\0';
+                    break;
+                }
             if (at)
-                report_entry(ld, at, "%s", msg);
+                report_entry(ld, at, "%s%s", msg, block_note);
             else
-                report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [%s] %s: %s", ld->name, param_section,
-                       law->params[bad].key, msg);
+                report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [%s] %s: %s%s", ld->name, param_section,
+                       law->params[bad].key, msg, block_note);
         }
     }
 }
@@ -777,6 +789,50 @@ static char *default_output_path(const char *name)
     if (path)
         snprintf(path, len + 4, "%.*s.h5", (int)len, base);
     return path;
+}
+
+/* The energy audit needs finite energies: a start state whose energy overflows a double
+ * is refused here rather than reported as a NaN residual after the run. */
+static void check_initial_energy(loader *ld, const bk_model *m)
+{
+    double driver0 = bk_driver_position(&m->driver, 0.0);
+    for (size_t i = 0; i < m->n_blocks; ++i) {
+        const bk_block *b = &m->blocks[i];
+        const char *key = NULL;
+        double energy = 0.0;
+        if (!isfinite(energy = 0.5 * b->mass * b->v_init * b->v_init))
+            key = "v_init";
+        else if (!isfinite(energy = 0.5 * b->driver_stiffness * (driver0 - b->x_init) * (driver0 - b->x_init)))
+            key = "x_init";
+        if (!key)
+            continue;
+        char section[SECTION_LEN];
+        snprintf(section, sizeof section, "block.%zu", i);
+        entry *e = lookup(ld, section, key);
+        if (!e)
+            e = lookup(ld, "block", key);
+        if (!e)
+            e = lookup(ld, "driver", "start_position");
+        const char *what = strcmp(key, "v_init") == 0 ? "kinetic" : "elastic";
+        if (e)
+            report_entry(ld, e, "block %zu's initial %s energy overflows a double (%g J; allowed: a "
+                         "finite energy)", i, what, energy);
+        else
+            report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: block %zu's initial %s energy overflows a double",
+                   ld->name, i, what);
+        return;
+    }
+    double *x = malloc(m->n_blocks * sizeof *x);
+    if (!x) {
+        report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+        return;
+    }
+    for (size_t i = 0; i < m->n_blocks; ++i)
+        x[i] = m->blocks[i].x_init;
+    if (!isfinite(bk_model_elastic_energy(m, x, driver0)))
+        report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: the chain's initial elastic energy overflows a double "
+               "(check x_init, x_init_random and the stiffnesses)", ld->name);
+    free(x);
 }
 
 /* The chain: model, blocks, friction, driver. */
@@ -831,6 +887,7 @@ static void build_chain(loader *ld, bk_config *c)
     }
     gsl_rng_free(rng);
     bk_model_finalize(m);
+    check_initial_energy(ld, m);
     c->t_end = value_of(ld, "run", "t_end");
 }
 
@@ -911,6 +968,29 @@ static void build_prescribed(loader *ld, bk_config *c)
         report_entry(ld, t_end, "must be <= the schedule's length (%.10g s), got %s", total, t_end->value);
 }
 
+/* method = exact solves only affine scenes; say so here, before any output exists. */
+static void check_method_fits(loader *ld, const bk_config *c)
+{
+    entry *method = lookup(ld, "solver", "method");
+    if (!method || strcmp(method->value, "exact") != 0 || !c->model || c->prescribed ||
+        ld->error_rank != LONG_MAX)
+        return;
+    const bk_model *m = c->model;
+    if (bk_model_is_affine(m))
+        return;
+    for (size_t i = 0; i < m->n_blocks; ++i) {
+        const bk_friction_law *law = m->blocks[i].law;
+        if (law->n_state > 0 || !(law->flags & BK_FRICTION_CONSTANT_SLIDING)) {
+            report_entry(ld, method,
+                         "needs Coulomb friction (a constant sliding force, no friction state) on "
+                         "every block; block %zu uses law %s (allowed: auto, or an integrator such "
+                         "as gsl_rk8pd or cvode_bdf)",
+                         i, law->name);
+            return;
+        }
+    }
+}
+
 static int has_section(loader *ld, const char *section)
 {
     for (size_t i = 0; i < ld->n; ++i)
@@ -925,6 +1005,7 @@ static bk_config *build(loader *ld)
     bk_config *c = calloc(1, sizeof *c);
     if (!c)
         return NULL;
+    c->t_end = NAN; /* unknown until read: no cross-check against it before then */
     if (has_section(ld, "prescribed"))
         build_prescribed(ld, c);
     else
@@ -943,6 +1024,7 @@ static bk_config *build(loader *ld)
     s->max_transitions_per_instant = (long)value_of(ld, "solver", "max_transitions_per_instant");
     s->instant_window = value_of(ld, "solver", "instant_window");
     s->min_step = value_of(ld, "solver", "min_step");
+    check_method_fits(ld, c);
     c->wall_time_limit = value_of(ld, "run", "wall_time_limit");
 
     bk_output_options *o = &c->output;

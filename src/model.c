@@ -136,3 +136,13 @@ double bk_model_max_angular_frequency(const bk_model *model)
     }
     return sqrt(max_rate);
 }
+
+int bk_model_is_affine(const bk_model *model)
+{
+    if (model->n_friction_state > 0)
+        return 0;
+    for (size_t i = 0; i < model->n_blocks; ++i)
+        if (!(model->blocks[i].law->flags & BK_FRICTION_CONSTANT_SLIDING))
+            return 0;
+    return 1;
+}

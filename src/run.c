@@ -911,6 +911,13 @@ done:
                             fmax(fabs(st->elastic_change), fabs(st->kinetic_change)));
         double residual = st->work_driver - st->elastic_change - st->kinetic_change - st->dissipation;
         st->energy_residual = scale > 0.0 ? residual / scale : 0.0;
+        if (rc == BK_OK && !isfinite(st->energy_residual))
+            rc = BK_FAIL(err, BK_ERR_NUMERIC,
+                         "the energy audit overflowed at t = %.17g s (driver work %g J, elastic change %g J, "
+                         "kinetic change %g J, dissipation %g J): the motion's scale is beyond double "
+                         "precision",
+                         ctx.t_last_row, st->work_driver, st->elastic_change, st->kinetic_change,
+                         st->dissipation);
     }
     free_ctx(&ctx);
     return rc;

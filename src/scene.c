@@ -57,11 +57,9 @@ int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
     }
     /* Stateless constant-force laws and a constant-velocity driver make every frozen-mode
      * segment linear with constant coefficients. */
-    scene->affine = model->n_friction_state == 0;
+    scene->affine = bk_model_is_affine(model);
     for (size_t i = 0; i < n; ++i) {
         const bk_block *b = &model->blocks[i];
-        if (!(b->law->flags & BK_FRICTION_CONSTANT_SLIDING))
-            scene->affine = 0;
         scene->normal[i] = b->normal_force;
         scene->can_stick[i] = (b->law->flags & BK_FRICTION_STATIC_THRESHOLD) != 0;
         scene->x[i] = scene->x_ref[i] = b->x_init;

@@ -32,11 +32,31 @@ static int teardown(void **state)
     return system(cmd) == 0 ? 0 : -1;
 }
 
-/* Run a shell command; return its exit status, with stdout+stderr in *output (malloc'ed). */
+/* The binary under test: $BKSIM (make test-asan sets the sanitizer build), else ./bksim. */
+static const char *bksim_binary(void)
+{
+    const char *bin = getenv("BKSIM");
+    return bin && *bin ? bin : "./bksim";
+}
+
+/* Run a shell command, with "./bksim" standing for the binary under test; return its exit
+ * status, with stdout+stderr in *output (malloc'ed). */
 static int run(const char *command, char **output)
 {
-    char full[4096];
-    snprintf(full, sizeof full, "{ %s; } 2>&1", command);
+    char replaced[4096], full[4200];
+    const char *bin = bksim_binary();
+    size_t used = 0;
+    for (const char *c = command; *c && used + 1 < sizeof replaced;) {
+        if (strncmp(c, "./bksim", 7) == 0 && (c[7] == ' ' || c[7] == '\0')) {
+            used += (size_t)snprintf(replaced + used, sizeof replaced - used, "%s", bin);
+            c += 7;
+        } else {
+            replaced[used++] = *c++;
+        }
+    }
+    assert_true(used + 1 < sizeof replaced);
+    replaced[used] = '\0';
+    snprintf(full, sizeof full, "{ %s; } 2>&1", replaced);
     FILE *p = popen(full, "r");
     assert_non_null(p);
     size_t cap = 4096, len = 0;
@@ -247,7 +267,7 @@ static void test_bad_inputs(void **state)
     snprintf(out, sizeof out, "%s/never.h5", tmpdir);
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         write_config(path, cases[k].line, cases[k].replacement);
-        snprintf(cmd, sizeof cmd, "cd %s && %s/bksim run bad.ini -o %s", tmpdir, cwd, out);
+        snprintf(cmd, sizeof cmd, "cd %s && %s/%s run bad.ini -o %s", tmpdir, cwd, bksim_binary(), out);
         char *text = NULL;
         int status = run(cmd, &text);
         if (status != 2 || !strstr(text, cases[k].expect))
@@ -261,7 +281,7 @@ static void test_bad_inputs(void **state)
         assert_false(exists(part));
         free(text);
         /* check says the same */
-        snprintf(cmd, sizeof cmd, "cd %s && %s/bksim check bad.ini", tmpdir, cwd);
+        snprintf(cmd, sizeof cmd, "cd %s && %s/%s check bad.ini", tmpdir, cwd, bksim_binary());
         assert_int_equal(run(cmd, NULL), 2);
     }
     /* An unreadable config: I/O failure, exit 1, nothing written. */

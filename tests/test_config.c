@@ -224,6 +224,18 @@ static void test_rejections(void **state)
         {"mass = 1\n", long_line, "t.ini:4: line longer than 190 characters (250); split it"},
         {"mass = 1\n", "mass 1\n", "t.ini:4: syntax error"},
         {"[block]\n", "[block\n", "t.ini:3: syntax error"},
+        {"mass = 1\n", "mass = 0x1p0\n", "t.ini:4: [block] mass: not a number: \"0x1p0\""},
+        {"t_end = 5\n", "t_end = 5\n[solver]\nmethod = exact\n[friction.0]\nlaw = carlson_langer\nF0 = 5\n"
+         "sigma = 0.2\nalpha = 1\n",
+         "t.ini:15: [solver] method: needs Coulomb friction (a constant sliding force, no friction state) on "
+         "every block; block 0 uses law carlson_langer (allowed: auto, or an integrator such as gsl_rk8pd or "
+         "cvode_bdf)"},
+        {"mass = 1\n", "mass = 1\nv_init = 1e300\n",
+         "t.ini:5: [block] v_init: block 0's initial kinetic energy overflows a double (inf J; allowed: a finite energy)"},
+        {"mass = 1\n", "mass = 1\nx_init = -1e160\n",
+         "t.ini:5: [block] x_init: block 0's initial elastic energy overflows a double"},
+        {"mu_d = 0.5\n", "mu_d = 0.5\n[friction.0]\nmu_s = 0.4\n",
+         "t.ini:9: [friction] mu_d: must be <= mu_s (0.4), got 0.5 (block 0: t.ini:11 sets [friction.0] mu_s = 0.4)"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         char text[4096];
@@ -238,6 +250,16 @@ static void test_rejections(void **state)
         assert_null(c);
         assert_non_null(strstr(err.message, cases[k].message));
     }
+    /* A missing n_blocks stays the error when an interval is given: the interval <= t_end
+     * cross-check must not run against a t_end that was never read. */
+    char text[4096];
+    variant(text, sizeof text, "n_blocks = 1\n", "");
+    strncat(text, "[output]\ninterval = 1e-3\n", sizeof text - strlen(text) - 1);
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(text, "t.ini", NULL, 0, &c, &err), BK_ERR_CONFIG);
+    assert_string_equal(err.message,
+                        "t.ini: [model] n_blocks: required key missing (allowed: 1 <= n_blocks <= 1000000, an integer)");
 }
 
 /* The first error in file order wins. */

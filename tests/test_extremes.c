@@ -1,7 +1,8 @@
-/* Stability at the extremes: every back-end on extreme scenes, each under a wall-clock limit.
- * The outcome must be a correct result (checked against the closed form where one exists) or
- * a clear error (a message naming the limit or the failure), never a hang, a crash or a NaN.
- * Prints the back-end x extreme table the README's "extremes" section is made from. */
+/* Stability at the extremes: every back-end on extreme scenes, each under a wall-clock limit
+ * (a hang fails the test).  Every back-end must give the correct result (checked against the
+ * closed form where one exists, else a converged reference); the only refusal allowed is the
+ * exact stepper's, of non-affine scenes, with its message.  Prints the back-end x extreme
+ * table the README's "extremes" section is made from. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -40,8 +41,15 @@ static const extreme extremes[] = {
     {"rate-state L0 = 2e-7 m", RATE_STATE("L0 = 2e-7\n"), 0, 0, 0, 0, 0},
 };
 
-#define WALL_LIMIT 0.4 /* s per run */
+#define WALL_LIMIT 0.4 /* s per run; $BK_TEST_TIME_SCALE stretches it under sanitizers/valgrind */
 #define RTOL 1e-8
+
+static double scaled_wall_limit(void)
+{
+    const char *scale = getenv("BK_TEST_TIME_SCALE");
+    double factor = scale ? strtod(scale, NULL) : 1.0;
+    return WALL_LIMIT * (factor >= 1.0 ? factor : 1.0);
+}
 
 typedef struct recorder {
     bk_transition *tr;
@@ -89,12 +97,14 @@ static int run_scene(const char *text, const char *method, double rtol, double w
     snprintf(set_rtol, sizeof set_rtol, "solver.rtol=%g", rtol);
     const char *overrides[] = {set_method, set_rtol};
     bk_config *c = NULL;
-    assert_int_equal(bk_config_load_string(text, "extreme.ini", overrides, 2, &c, err), BK_OK);
+    int rc = bk_config_load_string(text, "extreme.ini", overrides, 2, &c, err);
+    if (rc != BK_OK)
+        return rc;
     c->wall_time_limit = wall_limit;
     if (r->exact)
         assert_int_equal(exact_solve(&r->exact->p, c->t_end, r->exact), 0);
     bk_sink sink = {.self = r, .sample = check_sample, .transition = keep_transition};
-    int rc = bk_run(c, &sink, stats, NULL, NULL, err);
+    rc = bk_run(c, &sink, stats, NULL, NULL, err);
     bk_config_free(c);
     assert_false(r->non_finite);
     return rc;
@@ -109,10 +119,21 @@ static int run_scene(const char *text, const char *method, double rtol, double w
 static const char *judge_coulomb(const extreme *e, const recorder *r, char *detail, size_t len)
 {
     const exact_solution *ex = r->exact;
+    /* Every breakaway the run reports must be one of the exact ones, in order, even when
+     * grazing stops (and the breakaways after them) were missed. */
     double worst_t = 0.0;
-    for (size_t k = 0; r->n == ex->n_events && k < r->n; ++k)
-        if (ex->events[k].to != BK_MODE_STICK)
-            worst_t = fmax(worst_t, fabs(r->tr[k].t - ex->events[k].t) / ex->events[k].t);
+    size_t next = 0, breakaways = 0;
+    for (size_t k = 0; k < r->n; ++k) {
+        if (r->tr[k].from != BK_MODE_STICK)
+            continue;
+        ++breakaways;
+        double t = r->tr[k].t;
+        while (next < ex->n_events && (ex->events[next].from != BK_MODE_STICK || ex->events[next].t < t * (1.0 - 1e-5)))
+            ++next; /* stops, and breakaways the run skipped by sliding through a grazing stop */
+        worst_t = fmax(worst_t, next < ex->n_events ? fabs(t - ex->events[next].t) / ex->events[next].t : INFINITY);
+        ++next;
+    }
+    assert_true(breakaways > 0);
     double amplitude = 2.0 * (0.6 - e->mu_d) * e->mass * 9.81 / e->k;
     double rtol_floor = 10.0 * RTOL * e->velocity * ex->phases[ex->n_phases - 1].t0;
     snprintf(detail, len, "%zu/%zu transitions, breakaway time error %.1e, position error %.1e of the amplitude",
@@ -150,15 +171,19 @@ static void outcome(const extreme *e, const char *method, const recorder *refere
         r.exact = &ex;
     bk_run_stats stats = {0};
     bk_error err = {0};
-    int rc = run_scene(e->text, method, RTOL, WALL_LIMIT, &r, &stats, &err);
     char detail[BK_ERROR_MESSAGE_LEN + 64];
     const char *verdict;
+    int rc = run_scene(e->text, method, RTOL, scaled_wall_limit(), &r, &stats, &err);
     if (rc != BK_OK) {
-        /* Not ok must still mean a clear error: a message, never a crash or a NaN. */
-        assert_true(rc < 0);
-        assert_true(err.message[0] != '\0');
-        verdict = rc == BK_ERR_INTERRUPTED ? "slow" : rc == BK_ERR_CONFIG ? "n/a" : "error";
+        /* The exact stepper refuses non-affine scenes at load time; nothing else may fail. */
+        verdict = "n/a";
         snprintf(detail, sizeof detail, "%s", err.message);
+        if (!(rc == BK_ERR_CONFIG && strcmp(method, "exact") == 0 && !e->coulomb_single))
+            print_error("%s / %s: %s\n", e->name, method, err.message);
+        assert_int_equal(rc, BK_ERR_CONFIG);
+        assert_string_equal(method, "exact");
+        assert_false(e->coulomb_single);
+        assert_non_null(strstr(err.message, "needs Coulomb friction"));
     } else if (e->coulomb_single) {
         verdict = judge_coulomb(e, &r, detail, sizeof detail);
     } else {
@@ -204,18 +229,23 @@ static void test_extremes(void **state)
     }
 }
 
-/* 1e4 stick-slip cycles: the exact stepper stays on the closed form; an integrator's phase
- * error grows no faster than linearly in the number of cycles, as rtol says it should. */
+/* 1e4 stick-slip cycles.  The exact solution's phase is neutral: a timing error made in one
+ * cycle is carried, not damped, so an integrator's transition times drift by about
+ * rtol x period per cycle, linearly in the number of cycles.  The exact stepper stays on
+ * the closed form.  (Every back-end's drift is in the benchmark, `bksim_bench --long-run`.) */
 static void test_long_run_phase(void **state)
 {
     (void)state;
-    const char *methods[] = {"exact", "cvode_adams"};
+    const char *methods[] = {"exact", "cvode_adams", "gsl_rk8pd"};
     exact_params p = {1, 1e4, 9.81, 0.6, 0.5, 1e-3, 0};
     exact_solution ex;
-    double t_end = 2300.0; /* ~1e4 cycles of 0.23 s */
+    double t_end = 2300.0; /* ~1e4 cycles */
     assert_int_equal(exact_solve(&p, t_end, &ex), 0);
-    assert_true(ex.n_events >= 2 * 10000);
-    for (size_t m = 0; m < 2; ++m) {
+    size_t cycles = ex.n_events / 2;
+    assert_true(cycles >= 10000);
+    double period = ex.events[3].t - ex.events[1].t;
+    const size_t window = 100; /* cycles compared at each end */
+    for (size_t m = 0; m < sizeof methods / sizeof methods[0]; ++m) {
         char set_method[64];
         snprintf(set_method, sizeof set_method, "solver.method=%s", methods[m]);
         const char *overrides[] = {set_method};
@@ -229,17 +259,23 @@ static void test_long_run_phase(void **state)
         double early = 0.0, late = 0.0;
         for (size_t k = 0; k < r.n; ++k) {
             double e = fabs(r.tr[k].t - ex.events[k].t);
-            if (k < 200)
+            if (k < 2 * window)
                 early = fmax(early, e);
-            else if (k + 200 >= r.n)
+            else if (k + 2 * window >= r.n)
                 late = fmax(late, e);
         }
-        print_message("%s: 1e4 cycles, phase error %.2g s over the first 100 cycles, %.2g s over the last 100\n",
-                      methods[m], early, late);
-        if (m == 0)
+        print_message("%s: %zu cycles, phase error %.2g s over the first %zu cycles, %.2g s over the last "
+                      "(rtol x period x cycles = %.2g s)\n",
+                      methods[m], cycles, early, window, late, RTOL * period * (double)cycles);
+        if (m == 0) {
             assert_true(late < 1e-12 * t_end);
-        else
-            assert_true(late < 1e-7 * t_end); /* drift ~ rtol per cycle, bounded */
+        } else {
+            /* Linear drift: within a few rtol x period per cycle, and growing no faster than
+             * the cycle count (quadratic growth would make late / early ~ 1e4). */
+            assert_true(early < 10.0 * RTOL * period * (double)window);
+            assert_true(late < 10.0 * RTOL * period * (double)cycles);
+            assert_true(late < 3.0 * (double)cycles / (double)window * fmax(early, 1e-3 * RTOL * period));
+        }
         free(r.tr);
         bk_config_free(c);
     }

@@ -979,11 +979,11 @@ static void test_export_errors(void **state)
     expect_export_error(f->path, "time,,x", -1, 0, BK_ERR_INVALID,
                         (const char *const[]){"empty dataset name", NULL});
     expect_export_error(f->path, NULL, 3, 0, BK_ERR_INVALID,
-                        (const char *const[]){"block 3 out of range", "3 blocks (0..2)", NULL});
+                        (const char *const[]){"block 3 out of range", "3 blocks (allowed: 0..2)", NULL});
     expect_export_error(f->path, NULL, -2, 0, BK_ERR_INVALID,
-                        (const char *const[]){"block -2 out of range", "(0..2)", NULL});
+                        (const char *const[]){"block -2 out of range", "(allowed: 0..2)", NULL});
     expect_export_error(f->path, NULL, 7, 1, BK_ERR_INVALID,
-                        (const char *const[]){"(0..2)", NULL});
+                        (const char *const[]){"(allowed: 0..2)", NULL});
 
     bk_config *c = make_config(2, BK_FIELD_X, 0, 0);
     char other[256];

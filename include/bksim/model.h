@@ -74,5 +74,8 @@ double bk_model_max_angular_frequency(const bk_model *model);
 void bk_model_neighbours(const bk_model *model, size_t i, long *left, long *right);
 /* Number of neighbours block i is coupled to (walls included), 0..2. */
 int bk_model_coupling_count(const bk_model *model, size_t i);
+/* 1 when every block's law is stateless with a constant sliding force (Coulomb): between
+ * mode changes the chain is then linear with constant coefficients (method = exact). */
+int bk_model_is_affine(const bk_model *model);
 
 #endif

@@ -2156,7 +2156,7 @@ int bk_h5_export(const char *path, const char *datasets, long block, int transit
     rc = read_n_blocks(file, path, &n_blocks, err);
     if (rc == BK_OK && (block < -1 || block >= n_blocks))
         rc = BK_FAIL(err, BK_ERR_INVALID,
-                     "block %ld out of range: %s has %lld block%s (0..%lld), or -1 for all",
+                     "block %ld out of range: %s has %lld block%s (allowed: 0..%lld)",
                      block, path, n_blocks, n_blocks == 1 ? "" : "s", n_blocks - 1);
     if (rc == BK_OK)
         rc = transitions ? export_transitions(file, path, block, out, err)
