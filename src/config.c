@@ -129,6 +129,10 @@ static const key_def keys[] = {
 
     NUM("solver", "min_step", "s", 0.0, 0.0, INFINITY, 0,
         "a step size below this stops the run with an error (0: no limit)"),
+    {"solver", {"arkode_table", "", 0, 0, 0, 0,
+                "Butcher table of arkode_erk (an explicit ARKODE_* table) or arkode_dirk (a DIRK one); default: "
+                "the method's own (Zonneveld 5_3_4, SDIRK 5_3_4)"},
+     BK_KEY_CHOICE, NULL, bk_solver_arkode_table, "default"},
 
     {"output", {"path", "", 0, 0, 0, 0, "HDF5 output file (bksim run -o overrides)"}, BK_KEY_TEXT, NULL, NULL,
      "config file name, .ini replaced by .h5"},
@@ -260,7 +264,7 @@ static void report_entry(loader *ld, const entry *e, const char *fmt, ...)
 {
     if (e->rank >= ld->error_rank)
         return;
-    char where[512], what[768];
+    char where[512], what[1792];
     location(ld, e, where, sizeof where);
     va_list ap;
     va_start(ap, fmt);
@@ -484,7 +488,7 @@ static int parse_fields(const char *text, double *out, char *bad, size_t bad_len
 /* Parse and range-check an entry's value against its definition; reports on failure. */
 static int check_value(loader *ld, entry *e, const key_def *def, const bk_param *param)
 {
-    char allowed[512];
+    char allowed[1536];
     format_allowed(def, param, allowed, sizeof allowed);
     bk_key_kind type = def ? def->type : BK_KEY_NUMBER;
     const char *v = e->value;
@@ -618,7 +622,7 @@ static const bk_friction_law *section_law(loader *ld, const entry *e)
 /* Sections, keys, duplicates and every value on its own. */
 static void check_entries(loader *ld, long n_blocks)
 {
-    char allowed[512];
+    char allowed[1536];
     for (size_t i = 0; i < ld->n; ++i) {
         entry *e = &ld->entries[i];
         if (e->superseded)
@@ -677,7 +681,7 @@ static void check_entries(loader *ld, long n_blocks)
 
 static void report_missing(loader *ld, const char *section, const bk_param *param, const key_def *def)
 {
-    char allowed[512];
+    char allowed[1536];
     format_allowed(def, param, allowed, sizeof allowed);
     report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [%s] %s: required key missing (allowed: %s)", ld->name,
            section, param->key, allowed);
@@ -968,10 +972,20 @@ static void build_prescribed(loader *ld, bk_config *c)
         report_entry(ld, t_end, "must be <= the schedule's length (%.10g s), got %s", total, t_end->value);
 }
 
-/* method = exact solves only affine scenes; say so here, before any output exists. */
+/* The method fits the scene and takes the options given: method = exact solves only
+ * affine scenes, arkode_table needs a method with tables.  Said here, before any output. */
 static void check_method_fits(loader *ld, const bk_config *c)
 {
     entry *method = lookup(ld, "solver", "method");
+    entry *table = lookup(ld, "solver", "arkode_table");
+    if (table && strcmp(table->value, "default") != 0 && ld->error_rank == LONG_MAX) {
+        const bk_solver_backend *b = bk_solver_backend_find(c->solver.method);
+        char message[768];
+        if (!b || !b->check_options)
+            report_entry(ld, table, "applies to method arkode_erk or arkode_dirk, not %s", c->solver.method);
+        else if (b->check_options(&c->solver, message, sizeof message) != 0)
+            report_entry(ld, table, "%s", message);
+    }
     if (!method || strcmp(method->value, "exact") != 0 || !c->model || c->prescribed ||
         ld->error_rank != LONG_MAX)
         return;
@@ -1024,6 +1038,8 @@ static bk_config *build(loader *ld)
     s->max_transitions_per_instant = (long)value_of(ld, "solver", "max_transitions_per_instant");
     s->instant_window = value_of(ld, "solver", "instant_window");
     s->min_step = value_of(ld, "solver", "min_step");
+    snprintf(s->arkode_table, sizeof s->arkode_table, "%s",
+             bk_solver_arkode_table((size_t)value_of(ld, "solver", "arkode_table")));
     check_method_fits(ld, c);
     c->wall_time_limit = value_of(ld, "run", "wall_time_limit");
 
@@ -1238,7 +1254,7 @@ static void write_default(FILE *out, const key_def *def, const bk_param *param)
 
 static void write_row(FILE *out, const key_def *def, const bk_param *param)
 {
-    char allowed[512];
+    char allowed[1536];
     format_allowed(def, param, allowed, sizeof allowed);
     const char *unit = param->unit && param->unit[0] ? param->unit : "-";
     fprintf(out, "| `%s` | %s | ", param->key, unit);

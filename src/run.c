@@ -865,6 +865,8 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
         .user = &ctx.scene,
         .rhs = bk_scene_rhs,
         .jacobian = bk_scene_jacobian,
+        .rhs_split = bk_scene_rhs_split,
+        .jacobian_implicit = bk_scene_jacobian_implicit,
         .roots = bk_scene_roots,
         .n_roots = n * ctx.scene.roots_per_block,
         .root_direction = ctx.scene.root_direction,

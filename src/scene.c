@@ -255,14 +255,18 @@ void bk_scene_unpack(bk_scene *scene, double t, const double *y)
     scene->dissipation = scene->dissipation_ref + y[scene->n_y - 1];
 }
 
-int bk_scene_rhs(double t, const double *y, double *ydot, void *user)
+/* The right-hand side, whole (f_implicit NULL) or split: the friction terms (the
+ * velocity rows' -s F / m, the state rates) into f_implicit and the rest into ydot. */
+static void rhs_parts(const bk_scene *scene, double t, const double *y, double *ydot, double *f_implicit)
 {
-    const bk_scene *scene = user;
     const bk_model *model = scene->model;
     double driver_pos = bk_driver_position(&model->driver, t);
     double driver_disp = bk_driver_displacement(&model->driver, scene->t_ref, t);
     double driver_force_sum = scene->stuck_force_ref + scene->stuck_taut_stiffness * driver_disp;
     double dissipation_rate = 0.0;
+    double *state_rates = f_implicit ? f_implicit : ydot;
+    if (f_implicit)
+        memset(f_implicit, 0, scene->n_y * sizeof *f_implicit);
     for (size_t k = 0; k < scene->n_active; ++k) {
         size_t i = scene->active[k], s = scene->slot[i];
         const bk_block *b = &model->blocks[i];
@@ -273,7 +277,12 @@ int bk_scene_rhs(double t, const double *y, double *ydot, void *user)
         double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
                                                 block_state(scene, y, i));
         ydot[s] = v_i;
-        ydot[s + 1] = (applied - dir * friction) / b->mass;
+        if (f_implicit) {
+            ydot[s + 1] = applied / b->mass;
+            f_implicit[s + 1] = -dir * friction / b->mass;
+        } else {
+            ydot[s + 1] = (applied - dir * friction) / b->mass;
+        }
         driver_force_sum += spring;
         dissipation_rate += dir * friction * v_i;
     }
@@ -291,10 +300,24 @@ int bk_scene_rhs(double t, const double *y, double *ydot, void *user)
          * constraint anyway, and |v| has no derivative there for the Jacobian. */
         double speed = bk_scene_stuck(scene, i) ? 0.0 : fabs(y[scene->slot[i] + 1]);
         b->law->state_rate(b->friction_params, speed, &y[scene->state_slot[i]],
-                           &ydot[scene->state_slot[i]]);
+                           &state_rates[scene->state_slot[i]]);
+        if (f_implicit)
+            for (size_t j = 0; j < b->law->n_state; ++j)
+                ydot[scene->state_slot[i] + j] = 0.0;
     }
     ydot[scene->n_y - 2] = bk_driver_velocity(&model->driver, t) * driver_force_sum;
     ydot[scene->n_y - 1] = dissipation_rate;
+}
+
+int bk_scene_rhs(double t, const double *y, double *ydot, void *user)
+{
+    rhs_parts(user, t, y, ydot, NULL);
+    return 0;
+}
+
+int bk_scene_rhs_split(double t, const double *y, double *f_explicit, double *f_implicit, void *user)
+{
+    rhs_parts(user, t, y, f_explicit, f_implicit);
     return 0;
 }
 
@@ -321,10 +344,10 @@ static void friction_derivatives(const bk_scene *scene, size_t i, double slip_ra
     *d_state = (up - down) / (2.0 * hs);
 }
 
-int bk_scene_jacobian(double t, const double *y, void *user,
-                      void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
+/* The Jacobian of the whole right-hand side, or (friction_only) of its friction part. */
+static void jacobian_parts(const bk_scene *scene, double t, const double *y, int friction_only,
+                           void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
 {
-    const bk_scene *scene = user;
     const bk_model *model = scene->model;
     double kc = model->coupling_stiffness;
     double speed = bk_driver_velocity(&model->driver, t);
@@ -334,28 +357,32 @@ int bk_scene_jacobian(double t, const double *y, void *user,
         const bk_block *b = &model->blocks[i];
         double dir = (double)scene->mode[i], v_i = y[s + 1], m = b->mass;
         double spring = model->spring == BK_SPRING_TENSION_ONLY && !scene->taut[i] ? 0.0 : b->driver_stiffness;
-        put(matrix, s, s + 1, 1.0); /* xi' = v */
-        /* Springs: the block's own stiffness, and its slipping partners. */
-        put(matrix, s + 1, s, -(spring + kc * bk_model_coupling_count(model, i)) / m);
-        const long partners[2] = {scene->left[i], scene->right[i]};
-        for (size_t p = 0; p < 2 && kc > 0.0; ++p)
-            if (partners[p] >= 0 && scene->slot[partners[p]] != NO_SLOT)
-                put(matrix, s + 1, scene->slot[partners[p]], kc / m);
+        if (!friction_only) {
+            put(matrix, s, s + 1, 1.0); /* xi' = v */
+            /* Springs: the block's own stiffness, and its slipping partners. */
+            put(matrix, s + 1, s, -(spring + kc * bk_model_coupling_count(model, i)) / m);
+            const long partners[2] = {scene->left[i], scene->right[i]};
+            for (size_t p = 0; p < 2 && kc > 0.0; ++p)
+                if (partners[p] >= 0 && scene->slot[partners[p]] != NO_SLOT)
+                    put(matrix, s + 1, scene->slot[partners[p]], kc / m);
+        }
         /* Friction: -dir F(dir v, state) / m. */
         const double *state = block_state(scene, y, i);
         double d_rate, d_state;
-        double force = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i, state);
         friction_derivatives(scene, i, dir * v_i, state, &d_rate, &d_state);
         put(matrix, s + 1, s + 1, -d_rate / m);
         if (state)
             put(matrix, s + 1, scene->state_slot[i], -dir * d_state / m);
+        if (friction_only)
+            continue;
         /* Energy rates: driver power V k (D - x), friction power dir F v. */
+        double force = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i, state);
         put(matrix, work_row, s, -speed * spring);
         put(matrix, dissipation_row, s + 1, dir * force + v_i * d_rate);
         if (state)
             put(matrix, dissipation_row, scene->state_slot[i], dir * v_i * d_state);
     }
-    if (scene->full_layout)
+    if (scene->full_layout && !friction_only)
         for (size_t i = 0; i < scene->n; ++i)
             if (bk_scene_stuck(scene, i)) {
                 size_t s = scene->slot[i];
@@ -383,6 +410,19 @@ int bk_scene_jacobian(double t, const double *y, void *user,
             put(matrix, q, s + 1, v_i >= 0.0 ? d_speed : -d_speed);
         }
     }
+}
+
+int bk_scene_jacobian(double t, const double *y, void *user,
+                      void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
+{
+    jacobian_parts(user, t, y, 0, put, matrix);
+    return 0;
+}
+
+int bk_scene_jacobian_implicit(double t, const double *y, void *user,
+                               void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
+{
+    jacobian_parts(user, t, y, 1, put, matrix);
     return 0;
 }
 

@@ -106,6 +106,12 @@ int bk_scene_rhs(double t, const double *y, double *ydot, void *scene);
 int bk_scene_jacobian(double t, const double *y, void *scene,
                       void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix);
 int bk_scene_roots(double t, const double *y, double *g, void *scene);
+/* The IMEX split of bk_scene_rhs (bk_ode_problem.rhs_split): friction implicit, the rest
+ * explicit; f_explicit + f_implicit = bk_scene_rhs. */
+int bk_scene_rhs_split(double t, const double *y, double *f_explicit, double *f_implicit, void *scene);
+/* d f_implicit / dy. */
+int bk_scene_jacobian_implicit(double t, const double *y, void *scene,
+                               void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix);
 
 /* Applied (spring) force on block i with the unpacked positions at driver position D. */
 double bk_scene_applied_force(const bk_scene *scene, size_t i, double driver_pos);

@@ -232,23 +232,20 @@ static void test_case_c(void **state)
 }
 
 /* A 10-block chain (coupled, asymmetric start, mixed mu_d): driver work = elastic +
- * kinetic energy change + dissipation, to ENERGY_FACTOR * rtol.  Dense linear solvers:
- * the energy quadratures' rows depend on every block, outside the layout's declared half
- * bandwidth, so a band difference-quotient Jacobian is wrong in those rows; cvode_bdf
- * with "band" (or "auto", which picks band here) fails on this chain (README, Solver
- * back-ends). */
-static void test_chain_energy(void **state)
+ * kinetic energy change + dissipation, to ENERGY_FACTOR * rtol; every back-end with a
+ * dense linear solver, and the implicit ones with a band solver too (the analytic Jacobian
+ * keeps the energy quadratures' rows, which depend on every block, out of the band; a
+ * band difference-quotient Jacobian would spill them into it: README, Solver back-ends). */
+static void chain_energy(const char *method, const char *linear_solver)
 {
-    (void)state;
     const double rtol = 1e-8;
-    header();
-    for (const bk_solver_backend *const *b = bk_solver_backends(); *b; ++b) {
-        scene_spec spec = paper_case(0.5, BK_SPRING_LINEAR, rtol, (*b)->name);
+    {
+        scene_spec spec = paper_case(0.5, BK_SPRING_LINEAR, rtol, method);
         spec.n = 10;
         spec.coupling = 2e4;
         spec.t_end = 3.0;
         bk_config *c = make_config(&spec);
-        snprintf(c->solver.linear_solver, sizeof c->solver.linear_solver, "dense");
+        snprintf(c->solver.linear_solver, sizeof c->solver.linear_solver, "%s", linear_solver);
         for (size_t i = 0; i < spec.n; ++i) {
             c->model->blocks[i].x_init = 1e-5 * sin(2.385 * (double)i);
             c->model->blocks[i].friction_params[1] = 0.45 + 0.01 * (double)(i % 5);
@@ -256,13 +253,63 @@ static void test_chain_energy(void **state)
         recorder r = {0};
         bk_run_stats stats;
         run_config(c, &r, &stats);
-        row((*b)->name, "chain10", rtol, &stats, "energy", fabs(stats.energy_residual));
+        row(method, linear_solver[0] == 'b' ? "chain10b" : "chain10", rtol, &stats, "energy",
+            fabs(stats.energy_residual));
         assert_true(r.n_transitions > 2 * spec.n);
         assert_true(stats.work_driver > 0.0);
         assert_true(fabs(stats.energy_residual) <= ENERGY_FACTOR * rtol);
         recorder_free(&r);
         free_config(c);
     }
+}
+
+static void test_chain_energy(void **state)
+{
+    (void)state;
+    header();
+    for (const bk_solver_backend *const *b = bk_solver_backends(); *b; ++b)
+        chain_energy((*b)->name, "dense");
+    const char *implicit[] = {"cvode_bdf", "arkode_dirk", "arkode_imex", "ida"};
+    for (size_t k = 0; k < sizeof implicit / sizeof implicit[0]; ++k)
+        chain_energy(implicit[k], "band");
+}
+
+/* Every Butcher table [solver] arkode_table offers, through arkode_erk or arkode_dirk:
+ * case A's transitions at the closed-form times to TIME_FACTOR * rtol. */
+static void test_arkode_tables(void **state)
+{
+    (void)state;
+    exact_solution ex;
+    exact_case(0.1, BK_SPRING_LINEAR, &ex);
+    header();
+    size_t tables = 0;
+    for (size_t i = 1; bk_solver_arkode_table(i); ++i, ++tables) {
+        const char *name = bk_solver_arkode_table(i);
+        bk_solver_options options = {.arkode_table = ""};
+        snprintf(options.arkode_table, sizeof options.arkode_table, "%s", name);
+        char message[1024];
+        const char *method = bk_solver_arkode_erk.check_options(&options, message, sizeof message) == 0
+                                 ? "arkode_erk"
+                                 : "arkode_dirk";
+        assert_int_equal(bk_solver_backend_find(method)->check_options(&options, message, sizeof message), 0);
+        scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, 1e-7, method);
+        bk_config *c = make_config(&spec);
+        c->solver.arkode_table[0] = '\0';
+        strncat(c->solver.arkode_table, name, sizeof c->solver.arkode_table - 1);
+        recorder r = {0};
+        bk_run_stats stats;
+        run_config(c, &r, &stats);
+        assert_int_equal(r.n_transitions, ex.n_events);
+        double worst = 0.0;
+        for (size_t k = 0; k < ex.n_events; ++k)
+            worst = fmax(worst, fabs(r.transitions[k].t - ex.events[k].t) / ex.events[k].t);
+        print_message("%-12s %-30s %7ld %8ld  dt/t %.2e\n", method, name, stats.steps, stats.rhs_evals, worst);
+        assert_true(worst <= TIME_FACTOR * spec.rtol);
+        recorder_free(&r);
+        free_config(c);
+    }
+    assert_int_equal(tables, 14 + 23);
+    exact_free(&ex);
 }
 
 /* --- ida's algebraic formulation on the chain configs ---------------------------------- */
@@ -491,6 +538,7 @@ int main(void)
         cmocka_unit_test(test_cases_a_b),
         cmocka_unit_test(test_case_c),
         cmocka_unit_test(test_chain_energy),
+        cmocka_unit_test(test_arkode_tables),
         cmocka_unit_test(test_ida_two_block_chain),
         cmocka_unit_test(test_ida_ten_block_chain),
     };

@@ -242,10 +242,21 @@ static void put_dense(void *matrix, size_t row, size_t col, double value)
     d->a[row * d->n + col] += value;
 }
 
+/* The whole right-hand side, or the implicit (friction) part of its IMEX split. */
+static void evaluate(bk_scene *s, int implicit_part, double t, const double *y, double *out)
+{
+    double rest[16];
+    if (implicit_part)
+        assert_int_equal(bk_scene_rhs_split(t, y, rest, out, s), 0);
+    else
+        assert_int_equal(bk_scene_rhs(t, y, out, s), 0);
+}
+
 /* The analytic Jacobian matches central differences of the right-hand side, for a chain
  * mixing Coulomb and the paper's rate-and-state law, tension-only springs, a periodic
- * wrap, slipping and stuck blocks; in the compact and the full layout. */
-static void check_jacobian(int full_layout)
+ * wrap, slipping and stuck blocks; in the compact and the full layout; and the same for
+ * the friction part of the IMEX split, whose two parts add up to the right-hand side. */
+static void check_jacobian(int full_layout, int implicit_part)
 {
     bk_model *m = make_chain(4, BK_SPRING_TENSION_ONLY);
     m->boundary = BK_BOUNDARY_PERIODIC;
@@ -274,14 +285,29 @@ static void check_jacobian(int full_layout)
     size_t n = s.n_y;
     dense jac = {n, calloc(n * n, sizeof(double))};
     assert_non_null(jac.a);
-    assert_int_equal(bk_scene_jacobian(t, y, &s, put_dense, &jac), 0);
+    if (implicit_part) {
+        assert_int_equal(bk_scene_jacobian_implicit(t, y, &s, put_dense, &jac), 0);
+        double whole[16], f_explicit[16], f_implicit[16];
+        bk_scene_rhs(t, y, whole, &s);
+        bk_scene_rhs_split(t, y, f_explicit, f_implicit, &s);
+        for (size_t r = 0; r < n; ++r)
+            assert_close(f_explicit[r] + f_implicit[r], whole[r], 1e-15, 1e-300);
+        /* Friction only: positions and the energy quadratures are all explicit. */
+        for (size_t i = 0; i < 4; ++i)
+            if (s.slot[i] != SIZE_MAX)
+                assert_true(f_implicit[s.slot[i]] == 0.0);
+        assert_true(f_implicit[n - 1] == 0.0 && f_implicit[n - 2] == 0.0);
+        assert_true(f_implicit[s.state_slot[1]] != 0.0);
+    } else {
+        assert_int_equal(bk_scene_jacobian(t, y, &s, put_dense, &jac), 0);
+    }
     double up[16], down[16];
     for (size_t c = 0; c < n; ++c) {
         double saved = y[c], h = 1e-7 * fmax(fabs(saved), 1e-6);
         y[c] = saved + h;
-        bk_scene_rhs(t, y, up, &s);
+        evaluate(&s, implicit_part, t, y, up);
         y[c] = saved - h;
-        bk_scene_rhs(t, y, down, &s);
+        evaluate(&s, implicit_part, t, y, down);
         y[c] = saved;
         for (size_t r = 0; r < n; ++r) {
             double fd = (up[r] - down[r]) / (2 * h);
@@ -298,8 +324,9 @@ static void check_jacobian(int full_layout)
 static void test_jacobian(void **state)
 {
     (void)state;
-    check_jacobian(0);
-    check_jacobian(1);
+    check_jacobian(0, 0);
+    check_jacobian(1, 0);
+    check_jacobian(0, 1);
 }
 
 int main(void)

@@ -36,6 +36,8 @@ typedef struct bk_solver_options {
     double instant_window;  /* s: transitions closer than this count as one instant;
                                NaN = auto (1e-6 of the fastest natural period) */
     double min_step;        /* s: a step below this is an error; 0 = no limit (default) */
+    char arkode_table[48];  /* ARKODE Butcher table of arkode_erk / arkode_dirk; "default":
+                               the method's own (Zonneveld 5_3_4, SDIRK 5_3_4) */
 } bk_solver_options;
 
 typedef struct bk_output_options {

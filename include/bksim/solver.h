@@ -43,6 +43,14 @@ typedef struct bk_ode_problem {
      * The start vector satisfies the constraints, and y' = diag(id) f(t0, y0) is consistent
      * with it.  jacobian is still d f / dy, algebraic rows included. */
     const double *differential_id;
+    /* Optional additive split f = f_E + f_I for IMEX methods, in one pass: f_I is the
+     * friction (its force in the velocity rows, the friction-state rates), stiff at low slip
+     * rates (rate-and-state's direct effect, d mu / d v ~ a / v) and at short slip
+     * distances (state relaxation ~ B v / L0); f_E the rest (kinematics, springs, energy
+     * quadratures).  jacobian_implicit is d f_I / dy, in jacobian's form.  NULL: no split. */
+    int (*rhs_split)(double t, const double *y, double *f_explicit, double *f_implicit, void *user);
+    int (*jacobian_implicit)(double t, const double *y, void *user,
+                             void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix);
 } bk_ode_problem;
 
 typedef struct bk_solver_counters {
@@ -79,9 +87,16 @@ typedef struct bk_solver_backend {
     int (*root_info)(void *mem, int *found);
     void (*counters)(void *mem, bk_solver_counters *counters); /* cumulative over starts */
     void (*destroy)(void *mem);
+    /* Options only some back-ends take ([solver] arkode_table): 0 if these are fine, else
+     * -1 with the reason in message.  NULL: the back-end takes none. */
+    int (*check_options)(const bk_solver_options *options, char *message, size_t len);
 } bk_solver_backend;
 
 const bk_solver_backend *bk_solver_backend_find(const char *name);
+/* Names [solver] arkode_table accepts, i = 0, 1, ... (NULL past the end): "default" first,
+ * then ARKODE 6.4's explicit tables that have an embedding (for arkode_erk), then its
+ * diagonally implicit ones (for arkode_dirk). */
+const char *bk_solver_arkode_table(size_t i);
 /* All registered back-ends, NULL-terminated. */
 const bk_solver_backend *const *bk_solver_backends(void);
 

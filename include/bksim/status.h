@@ -35,7 +35,7 @@ typedef enum bk_status {
 /* Text for a status code; never NULL. */
 const char *bk_strerror(int status);
 
-#define BK_ERROR_MESSAGE_LEN 1024
+#define BK_ERROR_MESSAGE_LEN 2048
 
 typedef struct bk_error {
     int status;                          /* last failure code, BK_OK when clear */

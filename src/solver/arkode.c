@@ -3,22 +3,22 @@
  * default order-4 pair), a diagonally implicit method and an additive (IMEX) pair, the last
  * two with Newton iteration and a dense or band direct linear solver.
  *
- * IMEX split: the compact ODE the run loop hands over has no part that is known to be
- * non-stiff (the springs, the friction state relaxation and the rate-dependent friction
- * all enter the same components), and the interface does not expose one.  arkode_imex
- * therefore treats the whole right-hand side implicitly and gives the explicit tableau a
- * right-hand side that is identically zero: it runs the implicit (ESDIRK) half of
- * Kennedy & Carpenter's ARK4(3)6L[2]SA pair with that pair's embedding, which differs from
- * arkode_dirk only in the tableau.  It is a hook for a real split, not one.
+ * IMEX split (arkode_imex, Kennedy & Carpenter's ARK4(3)6L[2]SA): the problem's
+ * rhs_split gives the friction terms (stiff: the direct effect at low slip rates, the
+ * state's relaxation at small L0) to the ESDIRK half, with their own Jacobian
+ * (jacobian_implicit), and the springs, kinematics and energy quadratures to the explicit
+ * half.  ARKODE asks for both halves at each stage point; one rhs_split call, cached per
+ * (t, y), serves both.  A problem without a split runs the whole right-hand side
+ * implicitly, as arkode_dirk does but with the ARK pair's ESDIRK table.
  *
  * Dense output and root finding are ARKODE's own (Hermite interpolation of the step,
  * roots located on it); the state returned at a root is at ARKODE's upper bracket, just
  * past the crossing, as with CVODE.  Like cvode.c, a restart of equal size reinitialises
  * and a size change rebuilds every object.
  *
- * rhs_evals counts fe + fi evaluations plus those ARKODE makes for difference-quotient
- * Jacobians (ARKStepGetNumLinRhsEvals); for arkode_imex the fe count is of the zero
- * function. */
+ * rhs_evals counts right-hand-side evaluations (for arkode_imex: rhs_split calls, each
+ * giving both halves) plus those ARKODE makes for difference-quotient Jacobians
+ * (ARKStepGetNumLinRhsEvals). */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -53,6 +53,83 @@ static const ark_variant variant_erk = {KIND_EXPLICIT, ARKODE_ZONNEVELD_5_3_4, A
 static const ark_variant variant_dirk = {KIND_IMPLICIT, ARKODE_ERK_NONE, ARKODE_SDIRK_5_3_4};
 static const ark_variant variant_imex = {KIND_IMEX, ARKODE_ARK436L2SA_ERK_6_3_4, ARKODE_ARK436L2SA_DIRK_6_3_4};
 
+/* The tables [solver] arkode_table selects.  Knoth-Wolke 3_3 is left out: it has no
+ * embedding, so no error estimate for adaptive steps. */
+#define TABLE(id) {#id, (int)id}
+typedef struct named_table {
+    const char *name;
+    int id;
+} named_table;
+static const named_table erk_tables[] = {
+    TABLE(ARKODE_HEUN_EULER_2_1_2), TABLE(ARKODE_BOGACKI_SHAMPINE_4_2_3), TABLE(ARKODE_ARK324L2SA_ERK_4_2_3),
+    TABLE(ARKODE_ZONNEVELD_5_3_4), TABLE(ARKODE_ARK436L2SA_ERK_6_3_4), TABLE(ARKODE_SAYFY_ABURUB_6_3_4),
+    TABLE(ARKODE_CASH_KARP_6_4_5), TABLE(ARKODE_FEHLBERG_6_4_5), TABLE(ARKODE_DORMAND_PRINCE_7_4_5),
+    TABLE(ARKODE_ARK548L2SA_ERK_8_4_5), TABLE(ARKODE_VERNER_8_5_6), TABLE(ARKODE_FEHLBERG_13_7_8),
+    TABLE(ARKODE_ARK437L2SA_ERK_7_3_4), TABLE(ARKODE_ARK548L2SAb_ERK_8_4_5),
+};
+static const named_table dirk_tables[] = {
+    TABLE(ARKODE_SDIRK_2_1_2), TABLE(ARKODE_BILLINGTON_3_3_2), TABLE(ARKODE_TRBDF2_3_3_2),
+    TABLE(ARKODE_KVAERNO_4_2_3), TABLE(ARKODE_ARK324L2SA_DIRK_4_2_3), TABLE(ARKODE_CASH_5_2_4),
+    TABLE(ARKODE_CASH_5_3_4), TABLE(ARKODE_SDIRK_5_3_4), TABLE(ARKODE_KVAERNO_5_3_4),
+    TABLE(ARKODE_ARK436L2SA_DIRK_6_3_4), TABLE(ARKODE_KVAERNO_7_4_5), TABLE(ARKODE_ARK548L2SA_DIRK_8_4_5),
+    TABLE(ARKODE_ARK437L2SA_DIRK_7_3_4), TABLE(ARKODE_ARK548L2SAb_DIRK_8_4_5),
+    TABLE(ARKODE_ESDIRK324L2SA_4_2_3), TABLE(ARKODE_ESDIRK325L2SA_5_2_3), TABLE(ARKODE_ESDIRK32I5L2SA_5_2_3),
+    TABLE(ARKODE_ESDIRK436L2SA_6_3_4), TABLE(ARKODE_ESDIRK43I6L2SA_6_3_4), TABLE(ARKODE_QESDIRK436L2SA_6_3_4),
+    TABLE(ARKODE_ESDIRK437L2SA_7_3_4), TABLE(ARKODE_ESDIRK547L2SA_7_4_5), TABLE(ARKODE_ESDIRK547L2SA2_7_4_5),
+};
+#undef TABLE
+#define N_ERK_TABLES (sizeof erk_tables / sizeof erk_tables[0])
+#define N_DIRK_TABLES (sizeof dirk_tables / sizeof dirk_tables[0])
+
+const char *bk_solver_arkode_table(size_t i)
+{
+    if (i == 0)
+        return "default";
+    if (i - 1 < N_ERK_TABLES)
+        return erk_tables[i - 1].name;
+    if (i - 1 - N_ERK_TABLES < N_DIRK_TABLES)
+        return dirk_tables[i - 1 - N_ERK_TABLES].name;
+    return NULL;
+}
+
+/* The id of `name` in the kind's list, or -1 ("default" is handled by the caller). */
+static int table_id(ark_kind kind, const char *name)
+{
+    const named_table *list = kind == KIND_EXPLICIT ? erk_tables : dirk_tables;
+    size_t n = kind == KIND_EXPLICIT ? N_ERK_TABLES : N_DIRK_TABLES;
+    for (size_t k = 0; k < n; ++k)
+        if (strcmp(list[k].name, name) == 0)
+            return list[k].id;
+    return -1;
+}
+
+static int check_table(ark_kind kind, const char *method, const bk_solver_options *options, char *message,
+                       size_t len)
+{
+    if (!options->arkode_table[0] || strcmp(options->arkode_table, "default") == 0 ||
+        table_id(kind, options->arkode_table) >= 0)
+        return 0;
+    const named_table *list = kind == KIND_EXPLICIT ? erk_tables : dirk_tables;
+    size_t n = kind == KIND_EXPLICIT ? N_ERK_TABLES : N_DIRK_TABLES;
+    int used = snprintf(message, len, "%s is not %s table (allowed for %s: default", options->arkode_table,
+                        kind == KIND_EXPLICIT ? "an explicit (ERK)" : "a diagonally implicit (DIRK)", method);
+    for (size_t k = 0; k < n && used > 0 && (size_t)used < len; ++k)
+        used += snprintf(message + used, len - (size_t)used, ", %s", list[k].name);
+    if (used > 0 && (size_t)used < len)
+        snprintf(message + used, len - (size_t)used, ")");
+    return -1;
+}
+
+static int check_erk(const bk_solver_options *options, char *message, size_t len)
+{
+    return check_table(KIND_EXPLICIT, "arkode_erk", options, message, len);
+}
+
+static int check_dirk(const bk_solver_options *options, char *message, size_t len)
+{
+    return check_table(KIND_IMPLICIT, "arkode_dirk", options, message, len);
+}
+
 typedef struct arkode_backend {
     ark_variant variant;
     bk_solver_options options;
@@ -64,6 +141,11 @@ typedef struct arkode_backend {
     size_t n;                     /* size the ARKODE objects were built for */
     int n_roots;                  /* size RootInit was called with */
     bk_ode_problem problem;
+    int split;                    /* arkode_imex on a problem with rhs_split */
+    double *cache_y, *cache_fe, *cache_fi; /* split: the last rhs_split, at (cache_t, cache_y) */
+    double cache_t;
+    int cache_valid;
+    long split_evals;             /* rhs_split calls in the current start */
     double t_stop;
     bk_solver_counters done;      /* counters of finished starts */
     char message[512];            /* last message from ARKODE's error handler */
@@ -83,14 +165,33 @@ static int rhs_adapter(sunrealtype t, N_Vector y, N_Vector ydot, void *user)
     return ark->problem.rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot), ark->problem.user);
 }
 
-/* The explicit half of arkode_imex: nothing is treated explicitly (see the top). */
-static int zero_rhs(sunrealtype t, N_Vector y, N_Vector ydot, void *user)
+/* One half of the IMEX split, from the cached rhs_split at (t, y). */
+static int split_half(sunrealtype t, N_Vector y, N_Vector ydot, arkode_backend *ark, int implicit)
 {
-    (void)t;
-    (void)y;
-    (void)user;
-    N_VConst(0.0, ydot);
+    const double *yy = N_VGetArrayPointer(y);
+    size_t n = ark->n;
+    if (!(ark->cache_valid && ark->cache_t == t && memcmp(ark->cache_y, yy, n * sizeof *yy) == 0)) {
+        ark->cache_valid = 0;
+        ark->split_evals++;
+        int rc = ark->problem.rhs_split(t, yy, ark->cache_fe, ark->cache_fi, ark->problem.user);
+        if (rc != 0)
+            return rc;
+        memcpy(ark->cache_y, yy, n * sizeof *yy);
+        ark->cache_t = t;
+        ark->cache_valid = 1;
+    }
+    memcpy(N_VGetArrayPointer(ydot), implicit ? ark->cache_fi : ark->cache_fe, n * sizeof *yy);
     return 0;
+}
+
+static int explicit_half(sunrealtype t, N_Vector y, N_Vector ydot, void *user)
+{
+    return split_half(t, y, ydot, user, 0);
+}
+
+static int implicit_half(sunrealtype t, N_Vector y, N_Vector ydot, void *user)
+{
+    return split_half(t, y, ydot, user, 1);
 }
 
 static int roots_adapter(sunrealtype t, N_Vector y, sunrealtype *g, void *user)
@@ -101,18 +202,15 @@ static int roots_adapter(sunrealtype t, N_Vector y, sunrealtype *g, void *user)
 
 static ARKRhsFn explicit_fn(const arkode_backend *ark)
 {
-    switch (ark->variant.kind) {
-    case KIND_EXPLICIT:
-        return rhs_adapter;
-    case KIND_IMEX:
-        return zero_rhs;
-    default:
-        return NULL;
-    }
+    if (ark->split)
+        return explicit_half;
+    return ark->variant.kind == KIND_EXPLICIT ? rhs_adapter : NULL;
 }
 
 static ARKRhsFn implicit_fn(const arkode_backend *ark)
 {
+    if (ark->split)
+        return implicit_half;
     return ark->variant.kind == KIND_EXPLICIT ? NULL : rhs_adapter;
 }
 
@@ -124,13 +222,13 @@ static void add_counters(arkode_backend *ark, bk_solver_counters *c)
         ARKStepGetNumRhsEvals(ark->arkode, &fe, &fi);
         ARKStepGetNumGEvals(ark->arkode, &roots);
         ARKStepGetNumErrTestFails(ark->arkode, &fails);
-        if (ark->variant.kind != KIND_EXPLICIT) {
+        if (implicit_fn(ark)) {
             ARKStepGetNumNonlinSolvIters(ark->arkode, &iters);
             ARKStepGetNumLinRhsEvals(ark->arkode, &fls);
         }
     }
     c->steps += steps;
-    c->rhs_evals += fe + fi + fls;
+    c->rhs_evals += (ark->split ? ark->split_evals : fe + fi) + fls;
     c->root_evals += roots;
     c->err_test_fails += fails;
     c->nonlin_iters += iters;
@@ -150,6 +248,11 @@ static void free_objects(arkode_backend *ark)
         N_VDestroy(ark->atol);
     if (ark->work)
         N_VDestroy(ark->work);
+    free(ark->cache_y);
+    free(ark->cache_fe);
+    free(ark->cache_fi);
+    ark->cache_y = ark->cache_fe = ark->cache_fi = NULL;
+    ark->cache_valid = 0;
     ark->arkode = NULL;
     ark->linear_solver = NULL;
     ark->matrix = NULL;
@@ -167,7 +270,8 @@ static int fail(arkode_backend *ark, bk_error *err, const char *what, int flag)
     return BK_ERR_SOLVER;
 }
 
-/* The problem's exact Jacobian (the implicit part is the whole right-hand side). */
+/* The exact Jacobian of the implicit part: the whole right-hand side's, or (IMEX) the
+ * friction's. */
 static int jacobian_adapter(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix jac, void *user,
                             N_Vector tmp1, N_Vector tmp2, N_Vector tmp3)
 {
@@ -176,7 +280,10 @@ static int jacobian_adapter(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix ja
     (void)tmp2;
     (void)tmp3;
     arkode_backend *ark = user;
-    return bk_sundials_jacobian(&ark->problem, t, N_VGetArrayPointer(y), jac, 1.0, 0.0);
+    bk_ode_problem implicit_part = ark->problem;
+    if (ark->split)
+        implicit_part.jacobian = ark->problem.jacobian_implicit;
+    return bk_sundials_jacobian(&implicit_part, t, N_VGetArrayPointer(y), jac, 1.0, 0.0);
 }
 
 static int create(void **mem, const bk_solver_options *options, const ark_variant *variant,
@@ -187,6 +294,14 @@ static int create(void **mem, const bk_solver_options *options, const ark_varian
         return BK_FAIL(err, BK_ERR_NOMEM, "ARKODE back-end: out of memory");
     ark->variant = *variant;
     ark->options = *options;
+    /* A chosen table replaces the method's own (only arkode_erk and arkode_dirk take one). */
+    int chosen = options->arkode_table[0] && strcmp(options->arkode_table, "default") != 0
+                     ? table_id(variant->kind, options->arkode_table)
+                     : -1;
+    if (chosen >= 0 && variant->kind == KIND_EXPLICIT)
+        ark->variant.erk = (ARKODE_ERKTableID)chosen;
+    else if (chosen >= 0 && variant->kind == KIND_IMPLICIT)
+        ark->variant.dirk = (ARKODE_DIRKTableID)chosen;
     ark->n_roots = -1;
     if (SUNContext_Create(NULL, &ark->ctx) != 0) {
         free(ark);
@@ -236,7 +351,12 @@ static int build_objects(arkode_backend *ark, size_t n, double t0, const double 
     ark->y = N_VNew_Serial(len, ark->ctx);
     ark->atol = N_VNew_Serial(len, ark->ctx);
     ark->work = N_VNew_Serial(len, ark->ctx);
-    if (!ark->y || !ark->atol || !ark->work)
+    if (ark->split) {
+        ark->cache_y = malloc(n * sizeof *ark->cache_y);
+        ark->cache_fe = malloc(n * sizeof *ark->cache_fe);
+        ark->cache_fi = malloc(n * sizeof *ark->cache_fi);
+    }
+    if (!ark->y || !ark->atol || !ark->work || (ark->split && (!ark->cache_y || !ark->cache_fe || !ark->cache_fi)))
         return BK_FAIL(err, BK_ERR_NOMEM, "ARKODE: cannot allocate a problem of size %zu", n);
     memcpy(N_VGetArrayPointer(ark->y), y0, n * sizeof *y0);
     ark->arkode = ARKStepCreate(explicit_fn(ark), implicit_fn(ark), t0, ark->y, ark->ctx);
@@ -245,10 +365,12 @@ static int build_objects(arkode_backend *ark, size_t n, double t0, const double 
     ARKStepSetErrHandlerFn(ark->arkode, capture_message, ark);
     ARKStepSetUserData(ark->arkode, ark);
     ARKStepSetNoInactiveRootWarn(ark->arkode);
-    int flag = ARKStepSetTableNum(ark->arkode, ark->variant.dirk, ark->variant.erk);
+    /* Without a split, arkode_imex integrates everything with the pair's ESDIRK half. */
+    ARKODE_ERKTableID erk = explicit_fn(ark) ? ark->variant.erk : ARKODE_ERK_NONE;
+    int flag = ARKStepSetTableNum(ark->arkode, ark->variant.dirk, erk);
     if (flag != ARK_SUCCESS)
         return fail(ark, err, "ARKStepSetTableNum", flag);
-    if (ark->variant.kind != KIND_EXPLICIT) {
+    if (implicit_fn(ark)) {
         if (use_band(ark, n)) {
             sunindextype bw = (sunindextype)ark->problem.half_bandwidth;
             ark->matrix = SUNBandMatrix(len, bw, bw, ark->ctx);
@@ -262,7 +384,8 @@ static int build_objects(arkode_backend *ark, size_t n, double t0, const double 
         flag = ARKStepSetLinearSolver(ark->arkode, ark->linear_solver, ark->matrix);
         if (flag != ARK_SUCCESS)
             return fail(ark, err, "ARKStepSetLinearSolver", flag);
-        if (ark->problem.jacobian && (flag = ARKStepSetJacFn(ark->arkode, jacobian_adapter)) != ARK_SUCCESS)
+        if ((ark->split ? ark->problem.jacobian_implicit : ark->problem.jacobian) &&
+        (flag = ARKStepSetJacFn(ark->arkode, jacobian_adapter)) != ARK_SUCCESS)
             return fail(ark, err, "ARKStepSetJacFn", flag);
         /* Rebuild the Newton matrix whenever gamma = h a_ii changes.  With ARKODE 6.4.1's
          * default (reuse while |gamma/gamma_old - 1| < 0.2) a step shortened by up to 20%
@@ -286,8 +409,11 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     ark->problem = *problem;
     ark->message[0] = '\0';
     add_counters(ark, &ark->done);
+    ark->split_evals = 0;
+    ark->cache_valid = 0; /* the scene behind the right-hand side changed */
+    int split = ark->variant.kind == KIND_IMEX && problem->rhs_split;
     int flag;
-    if (ark->arkode && ark->n == n) {
+    if (ark->arkode && ark->n == n && ark->split == split) {
         memcpy(N_VGetArrayPointer(ark->y), y0, n * sizeof *y0);
         /* Keeps the tables, the linear solver and every option set before. */
         flag = ARKStepReInit(ark->arkode, explicit_fn(ark), implicit_fn(ark), t0, ark->y);
@@ -295,6 +421,7 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
             return fail(ark, err, "ARKStepReInit", flag);
     } else {
         free_objects(ark);
+        ark->split = split;
         int rc = build_objects(ark, n, t0, y0, err);
         if (rc != BK_OK) {
             free_objects(ark);
@@ -388,27 +515,28 @@ static void destroy(void *mem)
     free(ark);
 }
 
-#define ARKODE_BACKEND(NAME, CREATE, DOC)                                                       \
+#define ARKODE_BACKEND(NAME, CREATE, CHECK, DOC)                                                \
     {                                                                                           \
         .name = NAME, .doc = DOC, .create = CREATE, .start = start, .step = step,               \
         .interpolate = interpolate, .last_step = last_step, .root_info = root_info,             \
-        .counters = counters, .destroy = destroy,                                               \
+        .counters = counters, .destroy = destroy, .check_options = CHECK,                       \
     }
 
 const bk_solver_backend bk_solver_arkode_bs23 = ARKODE_BACKEND(
-    "arkode_bs23", create_bs23,
+    "arkode_bs23", create_bs23, NULL,
     "ARKODE explicit Bogacki-Shampine 3(2), 4 stages (MATLAB ode23's pair): non-stiff");
 const bk_solver_backend bk_solver_arkode_dp45 = ARKODE_BACKEND(
-    "arkode_dp45", create_dp45,
+    "arkode_dp45", create_dp45, NULL,
     "ARKODE explicit Dormand-Prince 5(4), 7 stages (MATLAB ode45's pair): non-stiff");
 const bk_solver_backend bk_solver_arkode_erk = ARKODE_BACKEND(
-    "arkode_erk", create_erk,
-    "ARKODE explicit Zonneveld 4(3), 5 stages (ARKStep's default order-4 ERK): non-stiff");
+    "arkode_erk", create_erk, check_erk,
+    "ARKODE explicit Runge-Kutta, Zonneveld 4(3) (ARKStep's default order-4 ERK) or the "
+    "[solver] arkode_table chosen: non-stiff");
 const bk_solver_backend bk_solver_arkode_dirk = ARKODE_BACKEND(
-    "arkode_dirk", create_dirk,
-    "ARKODE SDIRK 4(3), 5 stages, L-stable (ARKStep's default order-4 DIRK), Newton with "
-    "dense/band direct solver: stiff");
+    "arkode_dirk", create_dirk, check_dirk,
+    "ARKODE diagonally implicit Runge-Kutta, SDIRK 4(3) L-stable (ARKStep's default order-4 "
+    "DIRK) or the [solver] arkode_table chosen; Newton with dense/band direct solver: stiff");
 const bk_solver_backend bk_solver_arkode_imex = ARKODE_BACKEND(
-    "arkode_imex", create_imex,
-    "ARKODE additive ARK4(3)6L[2]SA with the whole right-hand side implicit (explicit part "
-    "zero; no split is exposed), Newton with dense/band direct solver: stiff");
+    "arkode_imex", create_imex, NULL,
+    "ARKODE additive ARK4(3)6L[2]SA: friction implicit (Newton, dense/band direct solver), "
+    "springs and kinematics explicit");
