@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # The work-precision benchmark (make bench): every back-end x every rtol on the paper's cases
-# and on Coulomb chains, plus CPU per transition against chain length.  Writes, under bench/:
-#   results.tsv, scaling.tsv, machine.txt, wp_<case>.png (error vs CPU, log-log), scaling.png
-# Takes a few minutes (4 on the machine in bench/machine.txt); `scripts/bench.sh --quick` is a
-# smoke run into a temporary directory, `--plot-only` redraws the PNGs from the TSVs in bench/.
+# and on Coulomb chains, CPU per transition against chain length, and phase drift over 1e4
+# stick-slip cycles.  Writes, under bench/:
+#   results.tsv, scaling.tsv, scaling_slopes.tsv, long_run.tsv, machine.txt, tables.md,
+#   wp_<case>.png (error vs CPU, log-log), scaling.png
+# Takes about 15 minutes on the machine in bench/machine.txt; `scripts/bench.sh --quick` is
+# a smoke run into a temporary directory, `--plot-only` redraws the PNGs and tables from the
+# TSVs in bench/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bench=build/bench/bksim_bench
@@ -13,6 +16,8 @@ plot_only=0
 case "${1:-}" in
     --quick) quick=(--quick --repeats 1); out=$(mktemp -d) ;;
     --plot-only) plot_only=1 ;;
+    "") ;;
+    *) echo "usage: $0 [--quick | --plot-only]" >&2; exit 2 ;;
 esac
 mkdir -p "$out"
 
@@ -30,28 +35,49 @@ if [ $plot_only = 0 ]; then
 
     "$bench" "${quick[@]}" --out "$out/results.tsv"
     "$bench" --scaling "${quick[@]}" --out "$out/scaling.tsv"
+    "$bench" --long-run "${quick[@]}" --out "$out/long_run.tsv"
 fi
 
-# Error vs CPU per case, one curve per back-end; the exact stepper, being the Coulomb
-# reference (error 0), is a vertical line at its CPU time.
-for case in $(awk -F'\t' 'NR > 1 {print $1}' "$out/results.tsv" | sort -u); do
-    awk -F'\t' -v c="$case" 'NR > 1 && $1 == c && $4 == "ok" && $2 !~ /^reference/ && $10 != "nan" && $10 > 0 {
-            print $2, $5, $10 > "'"$out"'/wp_" c "_" $2 ".dat" }' "$out/results.tsv"
+# Columns of results.tsv, by name.
+col() { awk -F'\t' -v name="$1" 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == name) print i; exit }' "$out/results.tsv"; }
+c_case=$(col case); c_method=$(col method); c_status=$(col status); c_cpu=$(col cpu_s)
+c_events=$(col events); c_err=$(col error_x_m)
+
+# Error vs CPU per case, one curve per back-end.  Runs whose stick-slip events differ from
+# the reference's (lost or invented stops) are grey crosses, not points of their curve.  The
+# exact stepper, the Coulomb reference (error 0), is a vertical line at its CPU time; for
+# integrator references the largest reference_vs_* difference is a horizontal line: errors
+# below it are not resolved.
+colors=(black '#e41a1c' '#377eb8' '#4daf4a' '#984ea3' '#ff7f00' '#a65628' '#f781bf' '#999999' '#17becf' '#bcbd22' '#1f3b99')
+for case in $(awk -F'\t' -v c="$c_case" 'NR > 1 {print $c}' "$out/results.tsv" | sort -u); do
+    awk -F'\t' -v c="$case" -v cc="$c_case" -v cm="$c_method" -v cs="$c_status" -v ct="$c_cpu" -v ce="$c_events" -v cx="$c_err" -v dir="$out" '
+        NR > 1 && $cc == c && $cs == "ok" && $cm !~ /^reference/ && $cx != "nan" && $cx > 0 {
+            if ($ce == "same") print $ct, $cx > (dir "/wp_" c "_" $cm ".dat")
+            else print $ct, $cx > (dir "/wp_" c "_differ.dat")
+        }' "$out/results.tsv"
     plots=""
     k=0
-    colors=(black '#e41a1c' '#377eb8' '#4daf4a' '#984ea3' '#ff7f00' '#a65628' '#f781bf' '#999999' '#17becf' '#bcbd22' '#1f3b99')
-    for f in "$out"/wp_"$case"_*.dat; do
+    for b in $(awk -F'\t' -v cm="$c_method" 'NR > 1 && $cm !~ /^reference/ && !seen[$cm]++ {print $cm}' "$out/results.tsv"); do
+        f="$out/wp_${case}_$b.dat"
         [ -e "$f" ] || continue
-        method=$(basename "$f" .dat); method=${method#wp_"$case"_}
-        plots="$plots${plots:+, }'$f' using 2:3 with linespoints lw 1.5 lc rgb '${colors[k % 12]}' pt $((k % 13 + 1)) ps 1.1 title '$method'"
+        plots="$plots${plots:+, }'$f' using 1:2 with linespoints lw 1.5 lc rgb '${colors[k % 12]}' pt $((k % 13 + 1)) ps 1.1 title '$b'"
         k=$((k + 1))
     done
     [ -n "$plots" ] || continue
-    exact_cpu=$(awk -F'\t' -v c="$case" '$1 == c && $2 == "exact" && $4 == "ok" {print $5}' "$out/results.tsv")
-    exact_marker=""
-    if [ -n "$exact_cpu" ]; then
-        exact_marker="set arrow from $exact_cpu, graph 0 to $exact_cpu, graph 1 nohead dt 2 lw 2 lc rgb 'black'
+    differ="$out/wp_${case}_differ.dat"
+    [ -e "$differ" ] && plots="$plots, '$differ' using 1:2 with points pt 2 ps 1.6 lc rgb '#888888' title 'events differ from the reference'"
+    marker=""
+    exact_cpu=$(awk -F'\t' -v c="$case" -v cc="$c_case" -v cm="$c_method" -v cs="$c_status" -v ct="$c_cpu" \
+        '$cc == c && $cm == "exact" && $cs == "ok" {print $ct}' "$out/results.tsv")
+    floor=$(awk -F'\t' -v c="$case" -v cc="$c_case" -v cm="$c_method" -v cx="$c_err" \
+        '$cc == c && $cm ~ /^reference_vs_/ && $cx != "nan" && $cx > m {m = $cx} END {if (m > 0) print m}' "$out/results.tsv")
+    ref=$(awk -F'\t' -v c="$case" -v cc="$c_case" -v cm="$c_method" '$cc == c && $cm == "reference" {print $3; exit}' "$out/results.tsv")
+    if [ -n "$exact_cpu" ] && [ "$ref" = 0 ]; then
+        marker="set arrow from $exact_cpu, graph 0 to $exact_cpu, graph 1 nohead dt 2 lw 2 lc rgb 'black'
             set label 'exact stepper (the reference, error 0)' at $exact_cpu, graph 0.03 left offset 0.5, 0"
+    elif [ -n "$floor" ]; then
+        marker="set arrow from graph 0, first $floor to graph 1, first $floor nohead dt 2 lw 2 lc rgb 'black'
+            set label 'reference uncertainty (largest reference_vs_* difference): errors below are not resolved' at graph 0.01, first $floor offset 0, -0.8 left font ',10'"
     fi
     gnuplot <<GP
 set terminal pngcairo size 1200,800 font 'Sans,12' noenhanced
@@ -64,15 +90,34 @@ set xlabel 'CPU time per run [s] (median of repeats)'
 set ylabel 'max |x - x_ref| [m]'
 set grid
 set key outside right
-$exact_marker
+$marker
 plot $plots
 GP
     rm -f "$out"/wp_"$case"_*.dat
 done
 
-# CPU per transition vs chain length, with a slope-1 guide.
-for m in cvode_adams cvode_bdf gsl_rk8pd exact; do
-    awk -F'\t' -v m="$m" 'NR > 1 && $2 == m && $3 == "ok" {print $1, $6}' "$out/scaling.tsv" > "$out/scaling_$m.dat"
+# CPU per transition vs chain length, with a slope-1 guide; the slope of each curve from
+# 100 to 1000 blocks (least squares in log-log) into scaling_slopes.tsv.
+awk -F'\t' 'NR > 1 && $4 == "ok" && $2 >= 100 && $8 > 0 {
+        key = $1 "\t" $3; x = log($2); y = log($8)
+        n[key]++; sx[key] += x; sy[key] += y; sxx[key] += x * x; sxy[key] += x * y }
+    END { print "chain\tmethod\tpoints\tslope_100_1000"
+          for (k in n) if (n[k] >= 2) printf "%s\t%d\t%.3f\n", k, n[k],
+              (n[k] * sxy[k] - sx[k] * sy[k]) / (n[k] * sxx[k] - sx[k] * sx[k]) }' "$out/scaling.tsv" |
+    (read -r head; echo "$head"; sort) > "$out/scaling_slopes.tsv"
+plots=""
+k=0
+for chain in random uniform; do
+    for m in exact gsl_rk8pd cvode_adams arkode_dp45 cvode_bdf ida; do
+        f="$out/scaling_${chain}_$m.dat"
+        awk -F'\t' -v c="$chain" -v m="$m" 'NR > 1 && $1 == c && $3 == m && $4 == "ok" {print $2, $8}' "$out/scaling.tsv" > "$f"
+        if [ -s "$f" ]; then
+            dt=$([ $chain = uniform ] && echo 2 || echo 1)
+            label="$m$([ $chain = uniform ] && echo ' (uniform chain)' || true)$([ $m = cvode_bdf ] && echo ' (band)' || true)"
+            plots="$plots${plots:+, }'$f' using 1:2 with linespoints lw 2 dt $dt pt $((k % 13 + 1)) lc rgb '${colors[k % 12]}' title '$label'"
+        fi
+        k=$((k + 1))
+    done
 done
 gnuplot <<GP
 set terminal pngcairo size 1200,800 font 'Sans,12' noenhanced
@@ -85,11 +130,9 @@ set format y '1e%L'
 set grid
 set key top left
 f(x) = 1e-6 * x
-plot '$out/scaling_cvode_adams.dat' using 1:2 with linespoints lw 2 pt 7 title 'cvode_adams', \
-     '$out/scaling_cvode_bdf.dat' using 1:2 with linespoints lw 2 pt 5 title 'cvode_bdf (band)', \
-     '$out/scaling_gsl_rk8pd.dat' using 1:2 with linespoints lw 2 pt 11 title 'gsl_rk8pd', \
-     '$out/scaling_exact.dat' using 1:2 with linespoints lw 2 pt 9 title 'exact', \
-     f(x) with lines dt 2 lc rgb '#777777' title 'slope 1 (linear in N)'
+plot $plots, f(x) with lines dt 3 lc rgb '#777777' title 'slope 1 (linear in N)'
 GP
 rm -f "$out"/scaling_*.dat
+
+scripts/bench_tables.sh "$out" > "$out/tables.md"
 echo "benchmark written to $out/"

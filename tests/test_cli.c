@@ -801,8 +801,9 @@ static void test_restart_errors(void **state)
     free(text);
 }
 
-/* The benchmark's smoke run: every back-end on case B at three tolerances, all succeed and
- * the error against the exact stepper falls as rtol tightens. */
+/* The benchmark's smoke run: every back-end on case B at three tolerances, all succeed
+ * with the reference's stick-slip events and an error against the exact stepper that falls
+ * as rtol tightens; and the whole script (sweep, scaling, long run, plots, tables). */
 static void test_bench_smoke(void **state)
 {
     (void)state;
@@ -812,13 +813,15 @@ static void test_bench_smoke(void **state)
     double last_error = 0.0;
     int rows = 0;
     for (char *line = strtok(text, "\n"); line; line = strtok(NULL, "\n")) {
-        char name[64], status[16];
+        char name[64], status[16], events[16];
         double rtol, cpu, error_x;
-        if (sscanf(line, "%63s %63s %lf %15s %lf %*d %*d %*d %*d %lf", name, method, &rtol, status, &cpu,
-                   &error_x) != 6 || strcmp(name, "B_coulomb") != 0 || strncmp(method, "reference", 9) == 0)
+        if (sscanf(line, "%63s %63s %lf %15s %lf %*f %*f %*d %*d %*d %*d %*d %15s %*d %lf", name, method, &rtol,
+                   status, &cpu, events, &error_x) != 7 ||
+            strcmp(name, "B_coulomb") != 0 || strncmp(method, "reference", 9) == 0)
             continue;
         ++rows;
         assert_string_equal(status, "ok");
+        assert_string_equal(events, "same");
         /* Within one method's sweep the error falls (exact has a single row). */
         if (strcmp(method, last_method) == 0)
             assert_true(error_x < last_error);
@@ -827,6 +830,24 @@ static void test_bench_smoke(void **state)
     }
     free(text);
     assert_true(rows >= 20);
+    if (run("command -v gnuplot", NULL) != 0)
+        return; /* the plots need gnuplot (quickstart.sh installs it) */
+    assert_int_equal(run("scripts/bench.sh --quick", &text), 0);
+    char dir[512] = "";
+    const char *at = strstr(text, "benchmark written to ");
+    assert_non_null(at);
+    assert_int_equal(sscanf(at, "benchmark written to %511[^\n]", dir), 1);
+    free(text);
+    const char *files[] = {"results.tsv", "scaling.tsv", "long_run.tsv", "tables.md", "wp_B_coulomb.png",
+                           "scaling.png"};
+    for (size_t k = 0; k < sizeof files / sizeof files[0]; ++k) {
+        char path[600];
+        snprintf(path, sizeof path, "%s/%s", dir, files[k]);
+        assert_true(exists(path));
+    }
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(run(cmd, NULL), 0);
 }
 
 /* README's config reference is exactly what `bksim keys` prints. */

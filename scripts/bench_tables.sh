@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Markdown tables from the benchmark's TSVs (scripts/bench.sh writes them to bench/tables.md;
+# README's "Choosing a solver" quotes them): CPU and error of every back-end at rtol 1e-8,
+# the references' uncertainty, CPU per transition against chain length with the fitted
+# slopes, and the phase drift over 1e4 cycles.
+set -euo pipefail
+dir=${1:-bench}
+results=$dir/results.tsv
+
+# Cell: CPU in ms (error in m); "†" marks a run whose stick-slip events differ from the
+# reference's; an error below the reference's uncertainty is shown as "< uncertainty".
+awk -F'\t' '
+    NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
+    $c["method"] ~ /^reference_vs_/ { if ($c["error_x_m"] != "nan" && $c["error_x_m"] > floor[$1]) floor[$1] = $c["error_x_m"]; next }
+    $c["method"] == "reference" { ref[$1] = $c["rtol"]; next }
+    !($1 in seen_case) { seen_case[$1] = 1; cases[++nc] = $1 }
+    !($c["method"] in seen_method) { seen_method[$c["method"]] = 1; methods[++nm] = $c["method"] }
+    ($c["rtol"] == "1e-08" || ($c["method"] == "exact" && $c["rtol"] == "0")) {
+        key = $1 SUBSEP $c["method"]
+        if ($c["status"] != "ok") { cell[key] = "failed"; next }
+        err = $c["error_x_m"]
+        shown = (err + 0 == 0) ? "0 m" : sprintf("%.1e m", err)
+        if ($1 in floor && err + 0 < floor[$1]) shown = "< uncertainty"
+        cell[key] = sprintf("%.3g ms (%s)%s", 1000 * $c["cpu_s"], shown, $c["events"] == "same" ? "" : " †")
+    }
+    END {
+        printf "| case |"; for (m = 1; m <= nm; ++m) printf " %s |", methods[m]; print ""
+        printf "| --- |"; for (m = 1; m <= nm; ++m) printf " --- |"; print ""
+        for (k = 1; k <= nc; ++k) {
+            printf "| %s |", cases[k]
+            for (m = 1; m <= nm; ++m) { key = cases[k] SUBSEP methods[m]; printf " %s |", (key in cell) ? cell[key] : "n/a" }
+            print ""
+        }
+        print ""
+        print "| case | reference | its uncertainty (largest difference from the checks) |"
+        print "| --- | --- | --- |"
+        for (k = 1; k <= nc; ++k)
+            printf "| %s | %s | %s |\n", cases[k], ref[cases[k]] == "0" ? "exact stepper" : "integrator at rtol " ref[cases[k]],
+                   (cases[k] in floor) ? sprintf("%.1e m", floor[cases[k]]) : "0 (closed form)"
+    }' "$results"
+echo
+
+# CPU per transition (ms) against N, heterogeneous chain, then the uniform one.
+awk -F'\t' '
+    NR == 1 { next }
+    $4 == "ok" { key = $1 SUBSEP $2 SUBSEP $3; v[key] = sprintf("%.3g", 1000 * $8)
+                 if (!(($1 SUBSEP $3) in seen)) { seen[$1 SUBSEP $3] = 1; m[$1, ++nm[$1]] = $3 }
+                 if (!(($1 SUBSEP $2) in seenn)) { seenn[$1 SUBSEP $2] = 1; n[$1, ++nn[$1]] = $2 } }
+    END {
+        split("random uniform", chains, " ")
+        for (c = 1; c <= 2; ++c) {
+            ch = chains[c]; if (!(ch in nm)) continue
+            printf "| N (%s chain) |", ch; for (j = 1; j <= nm[ch]; ++j) printf " %s |", m[ch, j]; print ""
+            printf "| --- |"; for (j = 1; j <= nm[ch]; ++j) printf " --- |"; print ""
+            for (i = 1; i <= nn[ch]; ++i) {
+                printf "| %s |", n[ch, i]
+                for (j = 1; j <= nm[ch]; ++j) { key = ch SUBSEP n[ch, i] SUBSEP m[ch, j]; printf " %s |", (key in v) ? v[key] " ms" : "-" }
+                print ""
+            }
+            print ""
+        }
+    }' "$dir/scaling.tsv"
+echo "| chain | method | slope of CPU per transition vs N, 100 to 1000 blocks |"
+echo "| --- | --- | --- |"
+awk -F'\t' 'NR > 1 {printf "| %s | %s | %s |\n", $1, $2, $4}' "$dir/scaling_slopes.tsv"
+echo
+
+echo "| method (rtol 1e-8) | CPU | events | phase error, first 100 cycles | last 100 cycles | growth (last / first) |"
+echo "| --- | --- | --- | --- | --- | --- |"
+awk -F'\t' 'NR > 1 {printf "| %s | %.3g s | %s | %s s | %s s | %s |\n", $1, $4, $6, $7, $8, $9}' "$dir/long_run.tsv"
