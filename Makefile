@@ -26,7 +26,7 @@ TEST_SUPPORT := $(filter-out $(TEST_SRC),$(wildcard tests/*.c))
 objs = $(patsubst %.c,$(1)/%.o,$(2))
 
 .SECONDARY:
-.PHONY: all test test-plain test-asan test-valgrind lint clean paper bench install fuzz
+.PHONY: all test test-plain test-asan test-valgrind lint clean paper bench install fuzz fuzz-replay
 all: bksim
 
 build/libbksim.a: $(call objs,build,$(LIB_SRC))
@@ -102,6 +102,12 @@ fuzz: build-fuzz/$(FUZZ_TARGET)
 	build-fuzz/$(FUZZ_TARGET) -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=20 \
 	    -artifact_prefix=build-fuzz/artifacts/$(FUZZ_TARGET)- -dict=tests/fuzz/config.dict \
 	    build-fuzz/corpus-$(FUZZ_TARGET)
+
+# CI: build both harnesses and run every seed (configs/) and regression input through them
+# once: the harnesses stay buildable and their oracles hold on the corpus.
+fuzz-replay: build-fuzz/fuzz_config build-fuzz/fuzz_run
+	build-fuzz/fuzz_config -runs=0 configs/*/*.ini tests/fuzz/regressions/*.ini
+	build-fuzz/fuzz_run -runs=0 -timeout=20 configs/*/*.ini tests/fuzz/regressions/*.ini
 
 clean:
 	rm -rf build build-asan build-fuzz bksim

@@ -48,7 +48,7 @@ c_events=$(col events); c_err=$(col error_x_m)
 # exact stepper, the Coulomb reference (error 0), is a vertical line at its CPU time; for
 # integrator references the largest reference_vs_* difference is a horizontal line: errors
 # below it are not resolved.
-colors=(black '#e41a1c' '#377eb8' '#4daf4a' '#984ea3' '#ff7f00' '#a65628' '#f781bf' '#999999' '#17becf' '#bcbd22' '#1f3b99')
+colors=(black '#e41a1c' '#377eb8' '#4daf4a' '#984ea3' '#ff7f00' '#a65628' '#f781bf' '#006d6d' '#17becf' '#bcbd22' '#1f3b99')
 for case in $(awk -F'\t' -v c="$c_case" 'NR > 1 {print $c}' "$out/results.tsv" | sort -u); do
     awk -F'\t' -v c="$case" -v cc="$c_case" -v cm="$c_method" -v cs="$c_status" -v ct="$c_cpu" -v ce="$c_events" -v cx="$c_err" -v dir="$out" '
         NR > 1 && $cc == c && $cs == "ok" && $cm !~ /^reference/ && $cx != "nan" && $cx > 0 {

@@ -143,6 +143,9 @@ static const key_def keys[] = {
      BK_KEY_FIELDS, field_names, NULL, "all"},
     {"output", {"transitions", "", 1, 0, 1, 0, "write the /transitions table"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
     {"output", {"event_rows", "", 1, 0, 1, 0, "add a row at every transition instant"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
+    NUM("output", "max_bytes", "B", 1e10, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
+        "largest size the sample rows (t_end / interval, times the bytes per row for the fields and blocks) "
+        "may take: a guard against a typo in interval or n_blocks"),
     INT("output", "max_rows", 1e8, 1, 1e15, 0,
         "largest number of sample rows (t_end / interval) a run may write: a guard against a typo in interval"),
     NUM("output", "checkpoint_interval", "s", 0.0, 0.0, INFINITY, 0,
@@ -201,6 +204,7 @@ typedef struct entry {
     const char *override;      /* the --set text, or NULL */
     long rank;                 /* position for "first error" */
     int superseded;            /* replaced by a later override */
+    long first_of_key;         /* an earlier file entry of the same section and key, or -1 */
     double number;             /* parsed value (numbers, bools, enum index, list length) */
     double *list;              /* BK_KEY_LIST values, owned */
 } entry;
@@ -217,6 +221,10 @@ typedef struct loader {
     int line;
     int section_line;          /* line of the last [section] header read */
     int oom;
+    /* (section, key) -> the last live entry, so that lookups (per block, per key) cost O(1)
+     * and a config with many [block.I] sections loads in linear time. */
+    size_t *slots;             /* entry index + 1, 0 for an empty slot */
+    size_t n_slots;            /* a power of two, at least twice the entries */
 } loader;
 
 #define RANK_MISSING (LONG_MAX - 1)
@@ -283,8 +291,8 @@ static long split_section(const char *section, char *base, size_t len)
     }
     snprintf(base, len, "%.*s", (int)(dot - section), section);
     const char *digits = dot + 1;
-    if (!*digits)
-        return -2;
+    if (!*digits || (digits[0] == '0' && digits[1] != '\0'))
+        return -2; /* [block.00] would alias [block.0] */
     for (const char *p = digits; *p; ++p)
         if (!isdigit((unsigned char)*p))
             return -2;
@@ -326,13 +334,12 @@ static char *read_line(char *str, int num, void *stream)
     if (!*ld->cursor)
         return NULL;
     const char *start = ld->cursor;
-    const char *eol = strchr(start, '\n');
-    size_t len = eol ? (size_t)(eol - start) + 1 : strlen(start);
+    /* Lines end in LF, CRLF or a lone CR (old Mac files). */
+    const char *eol = strpbrk(start, "\r\n");
+    size_t content = eol ? (size_t)(eol - start) : strlen(start);
+    size_t len = content + (eol ? (eol[0] == '\r' && eol[1] == '\n' ? 2 : 1) : 0);
     ld->cursor = start + len;
     ld->line++;
-    size_t content = len - (eol ? 1 : 0);
-    if (content > 0 && start[content - 1] == '\r')
-        content--;
     if (content > MAX_LINE_CHARS) {
         char where[300];
         snprintf(where, sizeof where, "%s:%d", ld->name, ld->line);
@@ -407,7 +414,8 @@ static int parse_number(const char *text, double *out)
     double value = strtod(text, &end);
     while (end && isspace((unsigned char)*end))
         ++end;
-    if (end == text || *end != '\0' || errno == ERANGE || !isfinite(value))
+    /* ERANGE on underflow (1e-320) is a tiny number, which the ranges then judge. */
+    if (end == text || *end != '\0' || (errno == ERANGE && fabs(value) >= 1.0) || !isfinite(value))
         return -1;
     *out = value;
     return 0;
@@ -580,15 +588,61 @@ static int check_value(loader *ld, entry *e, const key_def *def, const bk_param 
     return -1;
 }
 
+static size_t hash_key(const char *section, const char *key)
+{
+    uint64_t h = 1469598103934665603u; /* FNV-1a */
+    for (const char *p = section; *p; ++p)
+        h = (h ^ (unsigned char)*p) * 1099511628211u;
+    h = (h ^ '\n') * 1099511628211u;
+    for (const char *p = key; *p; ++p)
+        h = (h ^ (unsigned char)*p) * 1099511628211u;
+    return (size_t)h;
+}
+
+/* The slot holding section/key, or the empty slot where it would go. */
+static size_t *find_slot(const loader *ld, const char *section, const char *key)
+{
+    size_t mask = ld->n_slots - 1;
+    for (size_t i = hash_key(section, key) & mask;; i = (i + 1) & mask) {
+        size_t *slot = &ld->slots[i];
+        if (*slot == 0)
+            return slot;
+        const entry *e = &ld->entries[*slot - 1];
+        if (strcmp(e->section, section) == 0 && strcmp(e->key, key) == 0)
+            return slot;
+    }
+}
+
+/* Index the live entries, in order, so each slot ends at the last one of its key; note a
+ * key given twice in the file (not by an override). */
+static int build_index(loader *ld)
+{
+    ld->n_slots = 16;
+    while (ld->n_slots < 2 * ld->n)
+        ld->n_slots *= 2;
+    ld->slots = calloc(ld->n_slots, sizeof *ld->slots);
+    if (!ld->slots)
+        return -1;
+    for (size_t i = 0; i < ld->n; ++i) {
+        entry *e = &ld->entries[i];
+        e->first_of_key = -1;
+        if (e->superseded)
+            continue;
+        size_t *slot = find_slot(ld, e->section, e->key);
+        if (*slot != 0 && !e->override && !ld->entries[*slot - 1].override) {
+            const entry *earlier = &ld->entries[*slot - 1];
+            e->first_of_key = earlier->first_of_key >= 0 ? earlier->first_of_key : (long)(*slot - 1);
+        }
+        *slot = i + 1;
+    }
+    return 0;
+}
+
 /* The last (not superseded) entry for section/key, or NULL. */
 static entry *lookup(loader *ld, const char *section, const char *key)
 {
-    for (size_t i = ld->n; i-- > 0;) {
-        entry *e = &ld->entries[i];
-        if (!e->superseded && strcmp(e->section, section) == 0 && strcmp(e->key, key) == 0)
-            return e;
-    }
-    return NULL;
+    size_t slot = *find_slot(ld, section, key);
+    return slot ? &ld->entries[slot - 1] : NULL;
 }
 
 static void list_keys(const char *section, char *buf, size_t len)
@@ -648,14 +702,8 @@ static void check_entries(loader *ld, long n_blocks)
             continue;
         }
         /* A key given twice in one section of the file. */
-        for (size_t j = 0; j < i; ++j) {
-            entry *f = &ld->entries[j];
-            if (!f->superseded && !f->override && !e->override && strcmp(f->section, e->section) == 0 &&
-                strcmp(f->key, e->key) == 0) {
-                report_entry(ld, e, "duplicate key (first set at line %d)", f->line);
-                break;
-            }
-        }
+        if (e->first_of_key >= 0)
+            report_entry(ld, e, "duplicate key (first set at line %d)", ld->entries[e->first_of_key].line);
         const key_def *def = find_key(e->base, e->key);
         if (def) {
             check_value(ld, e, def, &def->param);
@@ -755,6 +803,15 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
     if (law->complete) {
         bk_friction_context ctx = {fabs(driver_speed), b->normal_force};
         law->complete(b->friction_params, &ctx);
+        /* A default derived from other values (theta_init = L0 / driver speed) can overflow; a NaN
+         * one is the law's to report (validate says which value it needs). */
+        for (size_t p = 0; p < law->n_params; ++p)
+            if (!origin[p] && isinf(b->friction_params[p]) && ld->error_rank == LONG_MAX) {
+                report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [%s] %s: its default for block %zu is not finite (%g); "
+                       "set it (allowed: %g < %s < %g)", ld->name, param_section, law->params[p].key, i,
+                       b->friction_params[p], law->params[p].min, law->params[p].key, law->params[p].max);
+                return;
+            }
     }
     if (law->validate) {
         char msg[256];
@@ -881,6 +938,11 @@ static void build_chain(loader *ld, bk_config *c)
         b->normal_force = block_value(ld, i, "normal_force", &given);
         if (!given)
             b->normal_force = b->mass * m->gravity;
+        if (!isfinite(b->normal_force) && ld->error_rank == LONG_MAX) {
+            report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [block] normal_force: the default mass * gravity of block %zu "
+                   "overflows (%g kg * %g m/s^2; allowed: 0 < normal_force < inf N)", ld->name, i, b->mass, m->gravity);
+            break;
+        }
         b->x_init = block_value(ld, i, "x_init", &given);
         /* Drawn for every block, so a block's value does not depend on its neighbours' keys. */
         b->x_init += block_value(ld, i, "x_init_random", &given) * (2.0 * gsl_rng_uniform(rng) - 1.0);
@@ -1058,6 +1120,9 @@ static bk_config *build(loader *ld)
     o->transitions = (int)value_of(ld, "output", "transitions");
     o->event_rows = (int)value_of(ld, "output", "event_rows");
     o->checkpoint_interval = value_of(ld, "output", "checkpoint_interval");
+    entry *checkpoints = lookup(ld, "output", "checkpoint_interval");
+    if (c->prescribed && checkpoints && o->checkpoint_interval > 0.0)
+        report_entry(ld, checkpoints, "a prescribed scene has no dynamics to checkpoint (allowed: 0)");
     o->max_rows = (long)value_of(ld, "output", "max_rows");
     double samples = o->interval > 0.0 ? c->t_end / o->interval : 0.0;
     if (samples > (double)o->max_rows) {
@@ -1068,6 +1133,35 @@ static bk_config *build(loader *ld)
         else
             report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [output] interval: the default t_end / 1000 gives "
                    "more than [output] max_rows = %ld rows", ld->name, o->max_rows);
+    }
+    o->max_bytes = value_of(ld, "output", "max_bytes");
+    if (c->model && ld->error_rank == LONG_MAX) {
+        /* Per row: time, driver, event; per block the chosen doubles and the int8 mode;
+         * energies and friction states as chosen. */
+        double per_block = 0.0;
+        const unsigned doubles[] = {BK_FIELD_X, BK_FIELD_V, BK_FIELD_FRICTION, BK_FIELD_COF};
+        for (size_t k = 0; k < sizeof doubles / sizeof doubles[0]; ++k)
+            per_block += (o->fields & doubles[k]) ? 8.0 : 0.0;
+        per_block += (o->fields & BK_FIELD_MODE) ? 1.0 : 0.0;
+        double per_row = 17.0 + per_block * (double)c->model->n_blocks +
+                         ((o->fields & BK_FIELD_ENERGY) ? 32.0 : 0.0) +
+                         ((o->fields & BK_FIELD_STATE) ? 8.0 * (double)c->model->n_friction_state : 0.0);
+        double bytes = (samples + 1.0) * per_row;
+        if (bytes > o->max_bytes) {
+            entry *at = interval ? interval : lookup(ld, "output", "max_bytes");
+            if (!at)
+                at = lookup(ld, "model", "n_blocks");
+            char where[512];
+            if (at)
+                location(ld, at, where, sizeof where);
+            else
+                snprintf(where, sizeof where, "%s", ld->name);
+            report(ld, at ? at->rank : RANK_MISSING, BK_ERR_CONFIG,
+                   "%s: [output] max_bytes: the sample rows would take about %.3g bytes (%.3g rows of %.3g "
+                   "bytes for %zu blocks), more than max_bytes = %.3g (allowed: a longer interval, fewer "
+                   "fields, or raise max_bytes)",
+                   where, bytes, samples + 1.0, per_row, c->model->n_blocks, o->max_bytes);
+        }
     }
     return c;
 }
@@ -1101,6 +1195,7 @@ static void free_loader(loader *ld)
         free(ld->entries[i].list);
     }
     free(ld->entries);
+    free(ld->slots);
 }
 
 /* Strip surrounding whitespace in place. */
@@ -1173,7 +1268,7 @@ int bk_config_load_string(const char *text, const char *name, const char *const 
         report(&ld, first_bad, BK_ERR_CONFIG,
                "%s:%d: syntax error: expected \"[section]\", \"key = value\" or a comment", name, first_bad);
     add_overrides(&ld, overrides, n_overrides);
-    if (ld.oom || first_bad < 0) {
+    if (ld.oom || first_bad < 0 || build_index(&ld) != 0) {
         free_loader(&ld);
         return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory while parsing", name);
     }

@@ -93,6 +93,7 @@ static double sample_time(const run_ctx *ctx, long k)
 }
 
 static double wall_seconds(void);
+static int report_progress(run_ctx *ctx, double t);
 
 /* Emit one row from the scene's unpacked state at time t. */
 static int emit_row(run_ctx *ctx, double t, int is_event)
@@ -123,14 +124,13 @@ static int emit_row(run_ctx *ctx, double t, int is_event)
     ctx->t_last_row = t;
     ctx->steps_since_row = 0;
     ctx->stats->rows++;
-    /* Rows can come without steps (all stuck, or dense sampling): the wall clock is
-     * checked here too. */
-    double limit = ctx->config->wall_time_limit;
-    if (limit > 0.0 && wall_seconds() - ctx->wall_start > limit)
-        return BK_FAIL(ctx->err, BK_ERR_INTERRUPTED,
-                       "[run] wall_time_limit = %g s reached at t = %.17g s of %g s", limit, t, ctx->t_end);
+    /* Rows can come without steps (all stuck, or dense sampling): a stop request and the
+     * wall clock are checked here too. */
+    int rc = report_progress(ctx, t);
+    if (rc != BK_OK)
+        return rc;
     if (ctx->sink && ctx->sink->sample) {
-        int rc = ctx->sink->sample(ctx->sink->self, &sample, ctx->err);
+        rc = ctx->sink->sample(ctx->sink->self, &sample, ctx->err);
         if (rc != BK_OK)
             return rc < 0 ? rc : BK_ERR_SINK;
     }

@@ -145,6 +145,11 @@ static void test_tolerated_forms(void **state)
     assert_int_equal(bk_config_load_string(text, "t.ini", NULL, 0, &c, &err), BK_OK);
     assert_close(c->model->blocks[0].mass, 1.0, 0, 0);
     bk_config_free(c);
+    /* Lone CR line ends (old Mac files), with line numbers intact. */
+    const char *cr = "[model]\rn_blocks = 1\r[block]\rmass = 1\rdriver_stiffness = 1e4\r[friction]\rlaw = coulomb\r"
+                     "mu_s = 0.6\rmu_d = 0.5\r[driver]\rvelocity = 1e-3\r[run]\rt_end = 5\rt_end = 6\r";
+    assert_int_equal(bk_config_load_string(cr, "t.ini", NULL, 0, &c, &err), BK_ERR_CONFIG);
+    assert_non_null(strstr(err.message, "t.ini:14: [run] t_end: duplicate key (first set at line 13)"));
 }
 
 /* Replace the line `line` (with its '\n') of minimal_config by `replacement`. */
@@ -225,6 +230,10 @@ static void test_rejections(void **state)
         {"mass = 1\n", "mass 1\n", "t.ini:4: syntax error"},
         {"[block]\n", "[block\n", "t.ini:3: syntax error"},
         {"mass = 1\n", "mass = 0x1p0\n", "t.ini:4: [block] mass: not a number: \"0x1p0\""},
+        {"mass = 1\n", "mass = 1\n[block.00]\nmass = 2\n", "t.ini:5: [block.00]: unknown section"},
+        {"driver_stiffness = 1e4\n", "driver_stiffness = -1e-320\n", "t.ini:5: [block] driver_stiffness: out of range, got -1e-320"},
+        {"t_end = 5\n", "t_end = 5\n[output]\nmax_bytes = 1e3\n",
+         "t.ini:15: [output] max_bytes: the sample rows would take about"},
         {"t_end = 5\n", "t_end = 5\n[solver]\nmethod = exact\n[friction.0]\nlaw = carlson_langer\nF0 = 5\n"
          "sigma = 0.2\nalpha = 1\n",
          "t.ini:15: [solver] method: needs Coulomb friction (a constant sliding force, no friction state) on "
@@ -330,6 +339,32 @@ static void test_file_errors(void **state)
 
 /* A [friction.I] that changes law takes none of [friction]'s parameters; a per-block
  * override of the same law inherits them. */
+/* Many [block.I] sections (a generated config): every one lands on its block, the last
+ * of a repeated key wins over [block], and a key given three times names its first line. */
+static void test_many_sections(void **state)
+{
+    (void)state;
+    const size_t n = 20000;
+    size_t cap = 64 * n + 1024, used = 0;
+    char *text = malloc(cap);
+    assert_non_null(text);
+    used += (size_t)snprintf(text, cap, "[model]\nn_blocks = %zu\n[block]\nmass = 1\ndriver_stiffness = 1e4\n"
+                             "x_init = 7e-6\n[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n[driver]\n"
+                             "velocity = 1e-3\n[run]\nt_end = 1\n", n);
+    for (size_t i = 0; i < n; i += 2)
+        used += (size_t)snprintf(text + used, cap - used, "[block.%zu]\nx_init = %zue-9\n", i, i);
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(text, "many.ini", NULL, 0, &c, &err), BK_OK);
+    for (size_t i = 0; i < n; i += 997)
+        assert_close(c->model->blocks[i].x_init, i % 2 ? 7e-6 : (double)i * 1e-9, 1e-15, 0);
+    bk_config_free(c);
+    free(text);
+    const char *triple = "[model]\nn_blocks = 1\n[block]\nmass = 1\nmass = 2\nmass = 3\n";
+    assert_int_equal(bk_config_load_string(triple, "t.ini", NULL, 0, &c, &err), BK_ERR_CONFIG);
+    assert_non_null(strstr(err.message, "t.ini:5: [block] mass: duplicate key (first set at line 4)"));
+}
+
 static void test_per_block_friction(void **state)
 {
     (void)state;
@@ -428,6 +463,7 @@ int main(void)
         cmocka_unit_test(test_overrides),
         cmocka_unit_test(test_file_errors),
         cmocka_unit_test(test_per_block_friction),
+        cmocka_unit_test(test_many_sections),
         cmocka_unit_test(test_shipped_configs),
         cmocka_unit_test(test_fuzz_regressions),
         cmocka_unit_test(test_reference),

@@ -182,7 +182,9 @@ static bk_transition transition_at(size_t k)
     static const int8_t from[] = {0, 1, 0, 0, 0};
     static const int8_t to[] = {1, 0, -1, 1, -1};
     bk_transition t = {
-        .t = 0.1 * (double)(k + 1) + 1.0 / 7.0,
+        /* Within [0, 0.2]: write_small's run ends there, and a check wants transitions
+         * inside the run. */
+        .t = 0.03 * (double)(k + 1) + 1.0 / 700.0,
         .block = blocks[k % 5],
         .from = from[k % 5],
         .to = to[k % 5],
@@ -249,11 +251,19 @@ static char *attr_string(hid_t obj, const char *name)
     assert_true(attr >= 0);
     hid_t type = H5Aget_type(attr);
     assert_int_equal(H5Tget_class(type), H5T_STRING);
-    assert_true(H5Tis_variable_str(type) > 0);
-    char *text = NULL;
-    assert_true(H5Aread(attr, type, &text) >= 0);
-    char *copy = strdup(text);
-    H5free_memory(text);
+    char *copy;
+    if (H5Tis_variable_str(type) > 0) {
+        char *text = NULL;
+        assert_true(H5Aread(attr, type, &text) >= 0);
+        copy = strdup(text);
+        H5free_memory(text);
+    } else {
+        /* Text written after the file was created is fixed-length (see the writer). */
+        size_t size = H5Tget_size(type);
+        copy = calloc(size + 1, 1);
+        assert_non_null(copy);
+        assert_true(H5Aread(attr, type, copy) >= 0);
+    }
     H5Tclose(type);
     H5Aclose(attr);
     return copy;
@@ -1147,6 +1157,552 @@ static void test_open_fails_cleanly(void **state)
     free_config(c);
 }
 
+/* ---- integrity (bk_h5_verify) on hand-damaged files ---- */
+
+/* write_small with these transitions instead of the usual five. */
+static void write_small_with(const char *path, const bk_transition *transitions, size_t n)
+{
+    bk_config *c = make_config(3, BK_FIELD_ALL, 1, 0);
+    c->t_end = 0.2;
+    bk_h5_writer *w;
+    bk_error err;
+    assert_int_equal(bk_h5_writer_open(&w, c, path, &err), BK_OK);
+    bk_sink sink = bk_h5_writer_sink(w);
+    double x[3] = {0.1, 0.2, 0.3}, v[3] = {0}, fr[3] = {1, 2, 3}, cof[3] = {0.6, 0.6, 0.6};
+    int8_t mode[3] = {0, 1, -1};
+    for (int r = 0; r < 3; ++r) {
+        bk_sample sample = {.t = 0.1 * r, .driver = 0.7 * r, .n_blocks = 3, .x = x, .v = v,
+                            .friction = fr, .cof = cof, .mode = mode};
+        assert_int_equal(sink.sample(sink.self, &sample, &err), BK_OK);
+    }
+    for (size_t k = 0; k < n; ++k)
+        assert_int_equal(sink.transition(sink.self, &transitions[k], &err), BK_OK);
+    bk_run_stats stats = example_stats();
+    assert_int_equal(bk_h5_writer_finish(w, &stats, &err), BK_OK);
+    free_config(c);
+}
+
+/* Overwrite one value of a 1-D or 2-D dataset through the plain HDF5 API. */
+static void poke(const char *path, const char *name, hsize_t row, hsize_t col, hid_t mem_type,
+                 const void *value)
+{
+    hid_t file = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(file >= 0);
+    hid_t dset = H5Dopen2(file, name, H5P_DEFAULT);
+    assert_true(dset >= 0);
+    hid_t space = H5Dget_space(dset);
+    int rank = H5Sget_simple_extent_ndims(space);
+    hsize_t offset[2] = {row, col}, count[2] = {1, 1};
+    assert_true(H5Sselect_hyperslab(space, H5S_SELECT_SET, offset, NULL, count, NULL) >= 0);
+    hid_t mem = H5Screate_simple(rank, count, NULL);
+    assert_true(H5Dwrite(dset, mem_type, mem, space, H5P_DEFAULT, value) >= 0);
+    H5Sclose(mem);
+    H5Sclose(space);
+    H5Dclose(dset);
+    H5Fclose(file);
+}
+
+/* Eight bytes of 0xff written over the stored chunk of dataset name that holds row, at that
+ * row (row_bytes per row): what a disk or a careless tool might do. */
+static void clobber_chunk(const char *path, const char *name, hsize_t row, size_t row_bytes)
+{
+    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(file >= 0);
+    hid_t dset = H5Dopen2(file, name, H5P_DEFAULT);
+    assert_true(dset >= 0);
+    hid_t dcpl = H5Dget_create_plist(dset);
+    hsize_t chunk[2] = {0, 0};
+    assert_true(H5Pget_chunk(dcpl, 2, chunk) >= 1);
+    H5Pclose(dcpl);
+    hsize_t origin[2] = {row / chunk[0] * chunk[0], 0};
+    unsigned mask = 0;
+    haddr_t addr = HADDR_UNDEF;
+    hsize_t size = 0;
+    assert_true(H5Dget_chunk_info_by_coord(dset, origin, &mask, &addr, &size) >= 0);
+    assert_true(addr != HADDR_UNDEF && size > 0);
+    H5Dclose(dset);
+    H5Fclose(file);
+    off_t at = (off_t)(addr + (row - origin[0]) * row_bytes);
+    assert_true((hsize_t)(row - origin[0]) * row_bytes + 8 <= size);
+    FILE *f = fopen(path, "r+b");
+    assert_non_null(f);
+    assert_int_equal(fseeko(f, at, SEEK_SET), 0);
+    static const unsigned char ff[8] = {0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff};
+    assert_int_equal(fwrite(ff, 1, 8, f), 8);
+    fclose(f);
+}
+
+static void expect_damaged(const char *path, const char *needle)
+{
+    bk_error err = {0};
+    int rc = bk_h5_verify(path, &err);
+    if (rc != BK_ERR_DAMAGED || !strstr(err.message, needle))
+        fail_msg("verify returned %d \"%s\", expected damaged with \"%s\"", rc, err.message, needle);
+    if (!strstr(err.message, path))
+        fail_msg("message \"%s\" does not name %s", err.message, path);
+    /* info prints its summary, says DAMAGED, and returns the same. */
+    char *text = NULL;
+    size_t len = 0;
+    FILE *out = open_memstream(&text, &len);
+    assert_int_equal(bk_h5_info(path, out, &err), BK_ERR_DAMAGED);
+    fclose(out);
+    assert_non_null(strstr(text, "integrity    DAMAGED: "));
+    assert_non_null(strstr(text, needle));
+    free(text);
+}
+
+static void test_verify_values(void **state)
+{
+    fixture *f = *state;
+    bk_error err = {0};
+    write_small(f->path, 0);
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+
+    double nan = NAN, inf = INFINITY, huge = 1e30;
+    write_small(f->path, 0);
+    poke(f->path, "x", 1, 2, H5T_NATIVE_DOUBLE, &nan);
+    expect_damaged(f->path, "/x row 1 column 2 is nan, not finite");
+
+    /* A large finite driver position is allowed; a non-finite one is not. */
+    write_small(f->path, 0);
+    poke(f->path, "driver", 2, 0, H5T_NATIVE_DOUBLE, &huge);
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+    poke(f->path, "driver", 2, 0, H5T_NATIVE_DOUBLE, &inf);
+    expect_damaged(f->path, "/driver row 2 is inf, not finite");
+
+    int8_t bad_mode = 77;
+    write_small(f->path, 0);
+    poke(f->path, "mode", 2, 1, H5T_NATIVE_INT8, &bad_mode);
+    expect_damaged(f->path, "/mode row 2 column 1 is 77, not a mode");
+
+    uint8_t bad_event = 2;
+    write_small(f->path, 0);
+    poke(f->path, "event", 0, 0, H5T_NATIVE_UINT8, &bad_event);
+    expect_damaged(f->path, "/event row 0 is 2, not 0 or 1");
+}
+
+static void test_verify_required_datasets(void **state)
+{
+    fixture *f = *state;
+    const char *names[] = {"x", "v", "transitions", "energy_kinetic", "driver"};
+    for (size_t k = 0; k < sizeof names / sizeof *names; ++k) {
+        write_small(f->path, 0);
+        hid_t file = H5Fopen(f->path, H5F_ACC_RDWR, H5P_DEFAULT);
+        assert_true(file >= 0);
+        char *recorded = attr_string(file, "datasets");
+        assert_string_equal(recorded, "time,driver,event,x,v,friction,cof,mode,energy_kinetic,"
+                                      "energy_elastic,work_driver,dissipation,transitions");
+        free(recorded);
+        assert_true(H5Ldelete(file, names[k], H5P_DEFAULT) >= 0);
+        H5Fclose(file);
+        char needle[64];
+        snprintf(needle, sizeof needle, "no /%s", names[k]);
+        expect_damaged(f->path, needle);
+    }
+    /* Datasets a run did not select are not required. */
+    bk_config *c = make_config(2, BK_FIELD_X, 0, 0);
+    c->t_end = row_time(2);
+    write_file(f->path, c, 3, 0);
+    bk_error err = {0};
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+    free_config(c);
+}
+
+static void test_verify_transitions(void **state)
+{
+    fixture *f = *state;
+    bk_transition ok[2] = {{.t = 0.05, .block = 0, .from = 0, .to = 1},
+                           {.t = 0.05, .block = 1, .from = 0, .to = -1}};
+    write_small_with(f->path, ok, 2);
+    bk_error err = {0};
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK); /* equal times are in order */
+
+    bk_transition backwards[2] = {{.t = 0.05, .block = 0, .from = 0, .to = 1},
+                                  {.t = 0.03, .block = 0, .from = 1, .to = 0}};
+    write_small_with(f->path, backwards, 2);
+    expect_damaged(f->path, "/transitions is not in time order at row 1");
+
+    bk_transition late[1] = {{.t = 0.5, .block = 2, .from = 0, .to = 1}};
+    write_small_with(f->path, late, 1);
+    expect_damaged(f->path, "/transitions row 0 is at t = 0.5 s, after the end of the run");
+
+    bk_transition early[1] = {{.t = -0.01, .block = 2, .from = 0, .to = 1}};
+    write_small_with(f->path, early, 1);
+    expect_damaged(f->path, "/transitions is not in time order at row 0");
+
+    bk_transition bad_mode[1] = {{.t = 0.1, .block = 1, .from = 0, .to = 3}};
+    write_small_with(f->path, bad_mode, 1);
+    expect_damaged(f->path, "/transitions row 0 goes from mode 0 to 3");
+
+    bk_transition nan_x[1] = {{.t = 0.1, .block = 1, .from = 0, .to = 1, .x = NAN}};
+    write_small_with(f->path, nan_x, 1);
+    expect_damaged(f->path, "/transitions row 0 has a value that is not finite");
+}
+
+/* Bytes damaged inside a chunk: the chunk's Fletcher32 checksum fails the read. */
+static void test_verify_flipped_chunk_bytes(void **state)
+{
+    fixture *f = *state;
+    write_small(f->path, 0);
+    clobber_chunk(f->path, "x", 1, 3 * sizeof(double));
+    expect_damaged(f->path, "/x rows 0..2 cannot be read");
+    bk_error err = {0};
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_ERR_DAMAGED);
+    assert_non_null(strstr(err.message, "HDF5:"));
+
+    write_small(f->path, 0);
+    clobber_chunk(f->path, "transitions", 2, 38);
+    expect_damaged(f->path, "/transitions");
+}
+
+/* ---- checkpoints and restarts of real runs ---- */
+
+/* A sink that passes everything to inner and stops the run `samples` rows after its
+ * `checkpoints`-th checkpoint, as a kill would (here cleanly, through abandon). */
+typedef struct stopping_sink {
+    bk_sink inner;
+    int checkpoints;
+    int samples;
+} stopping_sink;
+
+static int stopping_sample(void *self, const bk_sample *sample, bk_error *err)
+{
+    stopping_sink *s = self;
+    if (s->checkpoints == 0 && s->samples-- == 0)
+        return BK_FAIL(err, BK_ERR_INTERRUPTED, "stopped by the test");
+    return s->inner.sample(s->inner.self, sample, err);
+}
+
+static int stopping_transition(void *self, const bk_transition *t, bk_error *err)
+{
+    stopping_sink *s = self;
+    return s->inner.transition(s->inner.self, t, err);
+}
+
+static int stopping_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
+{
+    stopping_sink *s = self;
+    int rc = s->inner.checkpoint(s->inner.self, cp, err);
+    if (rc == BK_OK && s->checkpoints > 0)
+        --s->checkpoints;
+    return rc;
+}
+
+static bk_config *paper_config(const char *const *extra, size_t n_extra)
+{
+    const char *overrides[8] = {"output.checkpoint_interval=0.25", "run.t_end=1.2"};
+    size_t n = 2;
+    for (size_t k = 0; k < n_extra && n < 8; ++k)
+        overrides[n++] = extra[k];
+    bk_config *config = NULL;
+    bk_error err = {0};
+    int rc = bk_config_load_file("configs/paper/case_b_coulomb.ini", overrides, n, &config, &err);
+    if (rc != BK_OK)
+        fail_msg("%s", err.message);
+    return config;
+}
+
+/* Run config into path: whole (checkpoints < 0) or stopped `samples` rows after that many
+ * checkpoints, leaving path.part. */
+static void run_into(const bk_config *config, const char *path, int checkpoints, int samples)
+{
+    bk_h5_writer *w;
+    bk_error err = {0};
+    assert_int_equal(bk_h5_writer_open(&w, config, path, &err), BK_OK);
+    bk_sink inner = bk_h5_writer_sink(w);
+    stopping_sink stop = {inner, checkpoints < 0 ? -1 : checkpoints, samples};
+    bk_sink sink = {&stop, stopping_sample, stopping_transition, stopping_checkpoint};
+    bk_run_stats stats;
+    int rc = bk_run(config, checkpoints < 0 ? &inner : &sink, &stats, NULL, NULL, &err);
+    if (checkpoints < 0) {
+        if (rc != BK_OK)
+            fail_msg("%s", err.message);
+        assert_int_equal(bk_h5_writer_finish(w, &stats, &err), BK_OK);
+    } else {
+        assert_int_equal(rc, BK_ERR_INTERRUPTED);
+        bk_h5_writer_abandon(w, err.message, &stats);
+    }
+}
+
+/* Restart path.part and run it to the end; returns the checkpoint's t. */
+static double restart_to_end(const char *path)
+{
+    bk_h5_writer *w;
+    bk_config *config = NULL;
+    bk_checkpoint cp;
+    bk_error err = {0};
+    int rc = bk_h5_writer_resume(&w, part_of(path), &config, &cp, &err);
+    if (rc != BK_OK)
+        fail_msg("resume: %s", err.message);
+    bk_sink sink = bk_h5_writer_sink(w);
+    bk_run_stats stats;
+    rc = bk_run_from(config, &cp, &sink, &stats, NULL, NULL, &err);
+    if (rc != BK_OK)
+        fail_msg("run: %s", err.message);
+    double t = cp.t;
+    bk_checkpoint_free(&cp);
+    assert_int_equal(bk_h5_writer_finish(w, &stats, &err), BK_OK);
+    bk_config_free(config);
+    return t;
+}
+
+static void assert_same_run(const char *a, const char *b)
+{
+    static const char *const names[] = {"time", "driver", "event", "x", "v", "mode", "friction"};
+    bk_error err = {0};
+    for (size_t k = 0; k < sizeof names / sizeof *names; ++k) {
+        double *da = NULL, *db = NULL;
+        size_t ra, ca, rb, cb;
+        assert_int_equal(bk_h5_read_doubles(a, names[k], &da, &ra, &ca, &err), BK_OK);
+        assert_int_equal(bk_h5_read_doubles(b, names[k], &db, &rb, &cb, &err), BK_OK);
+        assert_int_equal(ra, rb);
+        assert_int_equal(ca, cb);
+        assert_memory_equal(da, db, ra * ca * sizeof *da);
+        free(da);
+        free(db);
+    }
+    bk_transition *ta = NULL, *tb = NULL;
+    size_t na, nb;
+    assert_int_equal(bk_h5_read_transitions(a, &ta, &na, &err), BK_OK);
+    assert_int_equal(bk_h5_read_transitions(b, &tb, &nb, &err), BK_OK);
+    assert_int_equal(na, nb);
+    for (size_t k = 0; k < na; ++k) { /* field by field: the struct has padding */
+        assert_true(memcmp(&ta[k].t, &tb[k].t, sizeof ta[k].t) == 0);
+        assert_true(memcmp(&ta[k].x, &tb[k].x, sizeof ta[k].x) == 0);
+        assert_true(memcmp(&ta[k].v, &tb[k].v, sizeof ta[k].v) == 0);
+        assert_true(memcmp(&ta[k].force, &tb[k].force, sizeof ta[k].force) == 0);
+        assert_true(ta[k].block == tb[k].block && ta[k].from == tb[k].from && ta[k].to == tb[k].to);
+    }
+    free(ta);
+    free(tb);
+    assert_int_equal(bk_h5_verify(b, &err), BK_OK);
+}
+
+/* The slot of /checkpoint with the higher sequence number ("a" or "b"). */
+static const char *newest_slot(const char *path)
+{
+    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(file >= 0);
+    hid_t a = H5Gopen2(file, "checkpoint/a", H5P_DEFAULT), b = H5Gopen2(file, "checkpoint/b", H5P_DEFAULT);
+    assert_true(a >= 0 && b >= 0);
+    const char *newest = attr_llong(a, "sequence") > attr_llong(b, "sequence") ? "a" : "b";
+    H5Gclose(a);
+    H5Gclose(b);
+    H5Fclose(file);
+    return newest;
+}
+
+static void set_slot_double_attr(const char *path, const char *slot, const char *name, double value)
+{
+    char group_name[64];
+    snprintf(group_name, sizeof group_name, "checkpoint/%s", slot);
+    hid_t file = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    hid_t group = H5Gopen2(file, group_name, H5P_DEFAULT);
+    hid_t attr = H5Aopen(group, name, H5P_DEFAULT);
+    assert_true(file >= 0 && group >= 0 && attr >= 0);
+    assert_true(H5Awrite(attr, H5T_NATIVE_DOUBLE, &value) >= 0);
+    H5Aclose(attr);
+    H5Gclose(group);
+    H5Fclose(file);
+}
+
+static void expect_resume_refused(const char *path, const char *needle)
+{
+    bk_h5_writer *w = NULL;
+    bk_config *config = NULL;
+    bk_checkpoint cp;
+    bk_error err = {0};
+    int rc = bk_h5_writer_resume(&w, part_of(path), &config, &cp, &err);
+    if (rc != BK_ERR_DAMAGED || !strstr(err.message, needle) || !strstr(err.message, part_of(path)))
+        fail_msg("resume returned %d \"%s\", expected damaged with \"%s\"", rc, err.message, needle);
+    assert_null(w);
+    assert_null(config);
+    double t = -1.0;
+    assert_int_equal(bk_h5_restartable(path, &t, &err), 0);
+    assert_true(t == -1.0);
+}
+
+/* A checkpoint written only in part (a kill between its arrays and its attributes) fails
+ * its checksum: a restart falls back to the slot before it and still ends with the output
+ * of an uninterrupted run; with both slots damaged it refuses, naming each fault. */
+static void test_restart_from_torn_checkpoint(void **state)
+{
+    fixture *f = *state;
+    bk_config *config = paper_config(NULL, 0);
+    char reference[256];
+    snprintf(reference, sizeof reference, "%s/reference.h5", f->dir);
+    run_into(config, reference, -1, 0);
+    bk_error err = {0};
+    assert_int_equal(bk_h5_verify(reference, &err), BK_OK);
+
+    /* Three checkpoints (t = 0.25, 0.5, 0.75): slot a holds the third, b the second. */
+    run_into(config, f->path, 3, 700);
+    const char *part = part_of(f->path);
+    assert_string_equal(newest_slot(part), "a");
+    assert_int_equal(bk_h5_verify(part, &err), BK_INCOMPLETE);
+    double t = 0;
+    assert_int_equal(bk_h5_restartable(f->path, &t, &err), 1);
+    assert_true(t == 0.75);
+    assert_int_equal(bk_h5_restartable(part, &t, &err), 1);
+
+    /* New positions reached the disk, the attributes did not (the auditor's case). */
+    double x = 0.123;
+    poke(part, "checkpoint/a/x", 0, 0, H5T_NATIVE_DOUBLE, &x);
+    assert_int_equal(bk_h5_restartable(f->path, &t, &err), 1);
+    assert_true(t == 0.5);
+    assert_int_equal(bk_h5_verify(part, &err), BK_INCOMPLETE); /* a verified slot remains */
+    assert_true(restart_to_end(f->path) == 0.5);
+    assert_same_run(reference, f->path);
+
+    /* Both slots damaged, one in an array and one in an attribute: refused. */
+    run_into(config, f->path, 3, 700);
+    poke(part, "checkpoint/a/x", 0, 0, H5T_NATIVE_DOUBLE, &x);
+    set_slot_double_attr(part, "b", "t", 0.55);
+    expect_resume_refused(f->path, "no checkpoint verifies, so a restart would continue from an "
+                                   "inconsistent state (/checkpoint/a: checksum mismatch");
+    expect_resume_refused(f->path, "/checkpoint/b: checksum mismatch");
+    expect_damaged(part, "no checkpoint verifies");
+
+    /* A slot that verifies but does not match the data: refused too. */
+    run_into(config, f->path, 1, 700);
+    double wrong_t = 0.2501;
+    hid_t file = H5Fopen(part, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hid_t slot = H5Gopen2(file, "checkpoint/a", H5P_DEFAULT);
+    hsize_t rows = (hsize_t)attr_llong(slot, "rows");
+    H5Gclose(slot);
+    H5Fclose(file);
+    poke(part, "time", rows - 1, 0, H5T_NATIVE_DOUBLE, &wrong_t);
+    expect_resume_refused(f->path, "/checkpoint/a: its last row is at t = ");
+    expect_resume_refused(f->path, "/checkpoint/b: not written");
+    bk_config_free(config);
+}
+
+/* A run killed while it rewrote the chunk that holds the checkpoint's last row leaves that
+ * chunk with a wrong checksum (its rows up to the checkpoint intact): info calls it damaged,
+ * and a restart rewrites the chunk and ends with the uninterrupted run's output. */
+static void test_restart_repairs_last_chunk(void **state)
+{
+    fixture *f = *state;
+    bk_config *config = paper_config(NULL, 0);
+    char reference[256];
+    snprintf(reference, sizeof reference, "%s/reference.h5", f->dir);
+    run_into(config, reference, -1, 0);
+    run_into(config, f->path, 2, 1200);
+    const char *part = part_of(f->path);
+    hid_t file = H5Fopen(part, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hid_t slot = H5Gopen2(file, "checkpoint/b", H5P_DEFAULT);
+    hsize_t rows = (hsize_t)attr_llong(slot, "rows");
+    H5Gclose(slot);
+    H5Fclose(file);
+    /* Rows after the checkpoint in the same chunks of /time (4096 rows) and /x (512). */
+    assert_true(rows % 4096 != 0 && rows % 4096 < 4096 - 2 && rows % 512 < 512 - 2);
+    clobber_chunk(part, "time", rows + 1, sizeof(double));
+    clobber_chunk(part, "x", rows + 1, sizeof(double));
+    bk_error err = {0};
+    assert_int_equal(bk_h5_verify(part, &err), BK_ERR_DAMAGED);
+    assert_non_null(strstr(err.message, "/time rows"));
+    double t = 0;
+    assert_int_equal(bk_h5_restartable(f->path, &t, &err), 1);
+    assert_true(t == 0.5);
+    assert_true(restart_to_end(f->path) == 0.5);
+    assert_same_run(reference, f->path);
+    bk_config_free(config);
+}
+
+/* bk_h5_restartable: only a .part with a checkpoint that verifies counts. */
+static void test_restartable(void **state)
+{
+    fixture *f = *state;
+    bk_error err = {0};
+    double t = -1.0;
+    assert_int_equal(bk_h5_restartable(f->path, &t, &err), 0); /* no file */
+    assert_int_equal(bk_h5_restartable(NULL, &t, &err), BK_ERR_INVALID);
+    assert_int_equal(bk_h5_restartable("", &t, &err), BK_ERR_INVALID);
+
+    /* A .part without checkpoints, and a complete output, are nothing to restart. */
+    const char *none[] = {"output.checkpoint_interval=0"};
+    bk_config *config = paper_config(none, 1);
+    run_into(config, f->path, 0, 700);
+    assert_true(exists(part_of(f->path)));
+    assert_int_equal(bk_h5_restartable(f->path, &t, &err), 0);
+    bk_config_free(config);
+    config = paper_config(NULL, 0);
+    run_into(config, f->path, -1, 0);
+    remove(part_of(f->path));
+    assert_int_equal(bk_h5_restartable(f->path, &t, &err), 0);
+    assert_true(t == -1.0);
+
+    /* Garbage under the .part name. */
+    FILE *g = fopen(part_of(f->path), "w");
+    assert_non_null(g);
+    fputs("not HDF5\n", g);
+    fclose(g);
+    assert_int_equal(bk_h5_restartable(f->path, &t, &err), 0);
+
+    run_into(config, f->path, 2, 10);
+    assert_int_equal(bk_h5_restartable(f->path, NULL, &err), 1);
+    assert_int_equal(bk_h5_restartable(f->path, &t, &err), 1);
+    assert_true(t == 0.5);
+    bk_config_free(config);
+}
+
+/* Every --set override comes back on a restart, however many (once cut at 256: the restart
+ * then ran with the wrong t_end). */
+static void test_restart_keeps_all_overrides(void **state)
+{
+    fixture *f = *state;
+    enum { N = 300 };
+    const char **overrides = calloc(N, sizeof *overrides);
+    assert_non_null(overrides);
+    overrides[0] = "output.checkpoint_interval=0.25";
+    for (size_t k = 1; k < N - 1; ++k)
+        overrides[k] = "run.t_end=2";
+    overrides[N - 1] = "run.t_end=0.9";
+    bk_config *config = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_file("configs/paper/case_b_coulomb.ini", overrides, N, &config, &err),
+                     BK_OK);
+    assert_true(config->t_end == 0.9);
+    run_into(config, f->path, 1, 10);
+    bk_config_free(config);
+    bk_h5_writer *w;
+    bk_checkpoint cp;
+    assert_int_equal(bk_h5_writer_resume(&w, f->path, &config, &cp, &err), BK_OK);
+    assert_int_equal(config->n_overrides, N);
+    assert_true(config->t_end == 0.9);
+    bk_sink sink = bk_h5_writer_sink(w);
+    bk_run_stats stats;
+    assert_int_equal(bk_run_from(config, &cp, &sink, &stats, NULL, NULL, &err), BK_OK);
+    bk_checkpoint_free(&cp);
+    assert_int_equal(bk_h5_writer_finish(w, &stats, &err), BK_OK);
+    bk_config_free(config);
+    free(overrides);
+    hid_t file = H5Fopen(f->path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(attr_double(file, "t_end") == 0.9);
+    H5Fclose(file);
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+}
+
+/* A file from before the "datasets" record: what must be there follows from its config. */
+static void test_verify_file_without_dataset_record(void **state)
+{
+    fixture *f = *state;
+    const char *fields[] = {"output.fields=x mode"};
+    bk_config *config = paper_config(fields, 1);
+    run_into(config, f->path, -1, 0);
+    bk_config_free(config);
+    hid_t file = H5Fopen(f->path, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(file >= 0);
+    assert_true(H5Adelete(file, "datasets") >= 0);
+    H5Fclose(file);
+    bk_error err = {0};
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+    file = H5Fopen(f->path, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(H5Ldelete(file, "mode", H5P_DEFAULT) >= 0);
+    H5Fclose(file);
+    expect_damaged(f->path, "no /mode");
+}
+
 int main(int argc, char **argv)
 {
     self_path = argv[0];
@@ -1174,6 +1730,15 @@ int main(int argc, char **argv)
         cmocka_unit_test_setup_teardown(test_missing_and_garbage_files, setup, teardown),
         cmocka_unit_test_setup_teardown(test_open_creates_directories, setup, teardown),
         cmocka_unit_test_setup_teardown(test_open_fails_cleanly, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_verify_values, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_verify_required_datasets, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_verify_transitions, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_verify_flipped_chunk_bytes, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_verify_file_without_dataset_record, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_restart_from_torn_checkpoint, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_restart_repairs_last_chunk, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_restartable, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_restart_keeps_all_overrides, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

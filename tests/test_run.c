@@ -469,6 +469,19 @@ static void test_interrupt(void **state)
     assert_true(r.last_t < 1.2);
     recorder_free(&r);
     free_config(c);
+    /* Also while every block is stuck and the run only writes rows (1e7 of them here, the
+     * first breakaway at 5.9e6 s): the request is seen at the next row. */
+    spec.velocity = 1e-9;
+    spec.t_end = 1e5;
+    spec.interval = 0.01;
+    c = make_config(&spec);
+    recorder stuck = {0};
+    sink.self = &stuck;
+    assert_int_equal(bk_run(c, &sink, NULL, stop_at_one_second, NULL, &err), BK_ERR_INTERRUPTED);
+    assert_int_equal(stuck.n_transitions, 0);
+    assert_true(stuck.last_t > 0.99 && stuck.last_t < 1.02);
+    recorder_free(&stuck);
+    free_config(c);
 }
 
 /* Rows: one per sample time plus one per transition instant, strictly increasing in time,

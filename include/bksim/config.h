@@ -48,6 +48,7 @@ typedef struct bk_output_options {
     int event_rows;    /* add a row at every transition instant; default 1 */
     double checkpoint_interval; /* s between checkpoints (restart points); 0 = none (default) */
     long max_rows;     /* sample rows t_end / interval may ask for; default 1e8 */
+    double max_bytes;  /* bytes those sample rows may take on disk (estimate); default 1e10 */
 } bk_output_options;
 
 /* A prescribed-motion scene (no dynamics): one block slides at a piecewise-constant slip

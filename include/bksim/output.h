@@ -8,9 +8,17 @@
  *   /energy_kinetic /energy_elastic /work_driver /dissipation (T) J,
  *   /friction_state (T x S) per law,
  *   /transitions compound {t, block, from, to, x, v, force}.
- * Root attributes: config (full text), config_name, version, n_blocks, complete (0 until the
- * run finished), t_end, t_reached; group /stats holds solver statistics as attributes.
- * The file is written as "<path>.part" and renamed to <path> only when complete. */
+ * Every chunked dataset carries Fletcher32 checksums, so damaged chunk bytes fail the read.
+ * Root attributes: config (full text), config_file and overrides (what a restart reloads),
+ * config_name, version, n_blocks, complete (0 until the run finished), t_end, t_reached, and
+ * datasets (the comma-separated names of the datasets the writer created); group /stats
+ * holds solver statistics as attributes.
+ * Group /checkpoint (with [output] checkpoint_interval) holds two slots, /checkpoint/a and
+ * /checkpoint/b, written in turn so that a crash while one is written leaves the other
+ * whole; each has a sequence number, the row counts of the datasets at the checkpoint and an
+ * FNV-1a checksum over all of it, and the newest slot that verifies is the checkpoint.
+ * The file is written as "<path>.part", synced to disk and renamed to <path> only when
+ * complete. */
 #ifndef BKSIM_OUTPUT_H
 #define BKSIM_OUTPUT_H
 
@@ -37,12 +45,24 @@ void bk_h5_writer_abandon(bk_h5_writer *writer, const char *reason, const bk_run
 
 /* Reopen the output of a run that stopped (<path>.part, or path given as the .part itself)
  * to continue it from its last checkpoint: reloads the config it stored (file text and
- * --set overrides), reads the checkpoint into *checkpoint (free with bk_checkpoint_free),
- * truncates every dataset to the rows written up to the checkpoint, and returns a writer
- * that appends from there and renames to <path> when finished.  On failure nothing is
+ * --set overrides), reads the newest checkpoint slot that verifies (checksum, row counts on
+ * disk, /time at its last row equal to the time it records) into *checkpoint (free with
+ * bk_checkpoint_free), truncates every dataset to the rows written up to the checkpoint, and
+ * returns a writer that appends from there and renames to <path> when finished.  Refuses
+ * with BK_ERR_DAMAGED when no checkpoint verifies (the message says what is wrong with each
+ * slot), BK_ERR_INVALID when there is no checkpoint or no .part.  On failure nothing is
  * returned and the file is unchanged. */
 int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config,
                         bk_checkpoint *checkpoint, bk_error *err);
+
+/* Whether "<path>.part" (path may also name the .part itself) holds the output of an
+ * unfinished run that `bksim run --restart` can continue: 1 when it has a checkpoint that
+ * verifies as bk_h5_writer_resume requires, with *t_checkpoint (may be NULL) set to that
+ * checkpoint's time; 0 when there is no such file, or it is unreadable, has no checkpoint or
+ * none that verifies (then err is left alone: overwriting it loses nothing a restart could
+ * use); negative with err filled only for a missing path or lack of memory.  Meant for
+ * refusing to overwrite restartable work. */
+int bk_h5_restartable(const char *path, double *t_checkpoint, bk_error *err);
 
 /* Summary of an output file: parameters, stick/slip phase counts, solver stats, and the
  * integrity check below.  Returns BK_OK for a complete, intact file, BK_INCOMPLETE for an
@@ -50,9 +70,13 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
  * negative code for a file that cannot be read. */
 int bk_h5_info(const char *path, FILE *out, bk_error *err);
 
-/* Integrity: root attributes present, /time /driver /event present, every time series as
- * long as /time with one column per block where per-block, /time finite and strictly
- * increasing, t_reached its last value, and for a complete run /time ending at t_end.
+/* Integrity: root attributes present; every dataset the writer created (root attribute
+ * datasets; for older files, those the stored config selects) present; every time series as
+ * long as /time with one column per block where per-block; every value read (so every
+ * chunk's Fletcher32 checksum checked), a block of rows at a time: all finite, /mode in
+ * {-1, 0, 1}, /event in {0, 1}, /time strictly increasing, t_reached its last value and, for
+ * a complete run, /time ending at t_end; /transitions in time order within the run, of
+ * existing blocks between valid modes; and a /checkpoint verifying as a restart requires.
  * Same returns as bk_h5_info. */
 int bk_h5_verify(const char *path, bk_error *err);
 

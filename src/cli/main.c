@@ -20,7 +20,7 @@ static const char *const usage_text =
     "usage: bksim <command> [options]\n"
     "\n"
     "commands:\n"
-    "  run CONFIG [-o OUT] [--set section.key=value]... [--quiet]\n"
+    "  run CONFIG [-o OUT] [--set section.key=value]... [--quiet] [--force]\n"
     "                       simulate the scene CONFIG describes, write HDF5 to OUT\n"
     "                       (default: [output] path)\n"
     "  run --restart OUT.h5[.part] [--quiet]\n"
@@ -36,7 +36,7 @@ static const char *const usage_text =
     "`bksim <command> --help` describes one command.\n";
 
 static const char *const run_help =
-    "usage: bksim run CONFIG [-o OUT] [--set section.key=value]... [--quiet]\n"
+    "usage: bksim run CONFIG [-o OUT] [--set section.key=value]... [--quiet] [--force]\n"
     "       bksim run --restart OUT.h5[.part] [--quiet]\n"
     "\n"
     "Runs the scene described by the INI file CONFIG and writes an HDF5 time series.\n"
@@ -47,6 +47,8 @@ static const char *const run_help =
     "  --set S.K=V        override key K of section S after reading CONFIG; S may be\n"
     "                     block.3 or friction.3 for one block (repeatable)\n"
     "  -q, --quiet        no progress indicator and no summary\n"
+    "  --force            start over even when OUT.part holds a checkpoint to restart from\n"
+    "                     (without it, run refuses to overwrite that progress)\n"
     "The file is written as OUT.part and renamed to OUT when the run completes; a failed\n"
     "or interrupted run leaves OUT.part marked complete = 0.\n";
 
@@ -85,6 +87,21 @@ static void on_signal(int signo)
     stop_requested = 1;
 }
 
+/* The first SIGINT, SIGTERM, SIGHUP (terminal gone) or SIGXCPU (a batch system's CPU limit)
+ * asks the run to stop at the next step or row and leave a valid, incomplete file; the
+ * handler then resets, so a second one stops the process at once. */
+static void catch_stop_signals(void)
+{
+    struct sigaction action;
+    memset(&action, 0, sizeof action);
+    action.sa_handler = on_signal;
+    action.sa_flags = (int)SA_RESETHAND;
+    sigemptyset(&action.sa_mask);
+    const int signals[] = {SIGINT, SIGTERM, SIGHUP, SIGXCPU};
+    for (size_t k = 0; k < sizeof signals / sizeof signals[0]; ++k)
+        sigaction(signals[k], &action, NULL);
+}
+
 static int wants_help(int argc, char **argv)
 {
     for (int i = 0; i < argc; ++i)
@@ -115,6 +132,7 @@ typedef struct config_args {
     const char **overrides;
     size_t n_overrides;
     int quiet;
+    int force;
 } config_args;
 
 static int parse_config_args(const char *command, int argc, char **argv, config_args *args)
@@ -140,6 +158,8 @@ static int parse_config_args(const char *command, int argc, char **argv, config_
             args->output = argv[++i];
         } else if (allow_output && (strcmp(a, "-q") == 0 || strcmp(a, "--quiet") == 0)) {
             args->quiet = 1;
+        } else if (allow_output && strcmp(a, "--force") == 0) {
+            args->force = 1;
         } else if (allow_output && strcmp(a, "--restart") == 0) {
             if (i + 1 >= argc)
                 return usage_error(command, "%s needs the output file of the stopped run", a);
@@ -272,6 +292,17 @@ static int cmd_run(int argc, char **argv)
                                                                                  : strdup(args.restart);
         path = restart_path;
     } else {
+        /* A stopped run's progress is not thrown away by running the same command again. */
+        double t_checkpoint = 0.0;
+        if (!args.force && path && bk_h5_restartable(path, &t_checkpoint, &err) == 1) {
+            fprintf(stderr,
+                    "%s.part holds a run stopped at its checkpoint t = %.17g s: continue it with "
+                    "`bksim run --restart %s.part`, or pass --force to start over\n",
+                    path, t_checkpoint, path);
+            bk_config_free(config);
+            free(args.overrides);
+            return EXIT_USAGE;
+        }
         opened = bk_h5_writer_open(&writer, config, path, &err);
     }
     if (opened != BK_OK) {
@@ -281,8 +312,7 @@ static int cmd_run(int argc, char **argv)
         free(restart_path);
         return opened == BK_ERR_INVALID || opened == BK_ERR_CONFIG ? EXIT_USAGE : EXIT_RUN_FAILED;
     }
-    signal(SIGINT, on_signal);
-    signal(SIGTERM, on_signal);
+    catch_stop_signals();
     progress_state progress = {!args.quiet && isatty(STDERR_FILENO), now_seconds(), 0.0, 0};
     bk_sink sink = bk_h5_writer_sink(writer);
     bk_run_stats stats;

@@ -9,6 +9,7 @@
 #include "bksim/output.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -18,6 +19,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/types.h>
+#include <unistd.h>
 
 #include <hdf5.h>
 
@@ -80,9 +82,9 @@ static herr_t innermost_error(unsigned n, const H5E_error2_t *e, void *data)
 
 /* Our message plus the most specific description on HDF5's error stack, which must still
  * hold the failure: call this before any further HDF5 call (closing ids clears it). */
-static int h5_fail(bk_error *err, const char *file, int line, const char *func,
-                   const char *fmt, ...) __attribute__((format(printf, 5, 6)));
-static int h5_fail(bk_error *err, const char *file, int line, const char *func,
+static int h5_fail(bk_error *err, int status, const char *file, int line, const char *func,
+                   const char *fmt, ...) __attribute__((format(printf, 6, 7)));
+static int h5_fail(bk_error *err, int status, const char *file, int line, const char *func,
                    const char *fmt, ...)
 {
     char detail[DETAIL_LEN] = "";
@@ -93,12 +95,15 @@ static int h5_fail(bk_error *err, const char *file, int line, const char *func,
     vsnprintf(message, sizeof message, fmt, ap);
     va_end(ap);
     if (detail[0])
-        return bk_error_set(err, BK_ERR_HDF5, file, line, func, "%s (HDF5: %s)", message,
-                            detail);
-    return bk_error_set(err, BK_ERR_HDF5, file, line, func, "%s", message);
+        return bk_error_set(err, status, file, line, func, "%s (HDF5: %s)", message, detail);
+    return bk_error_set(err, status, file, line, func, "%s", message);
 }
 
-#define H5_FAIL(err, ...) h5_fail((err), __FILE__, __LINE__, __func__, __VA_ARGS__)
+#define H5_FAIL(err, ...) h5_fail((err), BK_ERR_HDF5, __FILE__, __LINE__, __func__, __VA_ARGS__)
+/* A read that failed inside a file that opened: the file is damaged (a Fletcher32 checksum
+ * mismatch lands here), and HDF5's reason is kept. */
+#define H5_DAMAGED(err, ...) \
+    h5_fail((err), BK_ERR_DAMAGED, __FILE__, __LINE__, __func__, __VA_ARGS__)
 
 static void close_id(hid_t id)
 {
@@ -146,6 +151,16 @@ static void close_ids(int failed, const hid_t *ids, size_t n)
     close_ids((status) < 0, (const hid_t[]){__VA_ARGS__},      \
               sizeof((const hid_t[]){__VA_ARGS__}) / sizeof(hid_t))
 
+/* H5Fis_hdf5 is deprecated from HDF5 1.12 on. */
+static htri_t has_hdf5_signature(const char *path)
+{
+#if H5_VERSION_GE(1, 12, 0)
+    return H5Fis_accessible(path, H5P_DEFAULT);
+#else
+    return H5Fis_hdf5(path);
+#endif
+}
+
 /* ------------------------------------------------------------------ attributes --- */
 
 /* Create or overwrite a scalar attribute. */
@@ -192,6 +207,40 @@ static herr_t write_string_attr(hid_t obj, const char *name, const char *value)
     const char *text = value ? value : "";
     hid_t type = vlen_string_type();
     herr_t rc = type < 0 ? -1 : write_attr(obj, name, type, type, &text);
+    CLOSE_IDS(rc, type);
+    return rc;
+}
+
+/* A fixed-length UTF-8 string attribute, created or replaced.  Every string written after
+ * the file is created is one of these: a variable-length string lives in HDF5's global
+ * heap, and a kill while a rewrite of the heap is flushed can leave it in a state that
+ * HDF5 1.10 reads in an endless loop (seen with the checkpoint's method string, rewritten at
+ * every checkpoint: `bksim info` hung).  Fixed-length text sits in the attribute itself,
+ * inside the object header, so after the first flush the heap is never written again. */
+static herr_t write_fixed_string_attr(hid_t obj, const char *name, const char *value)
+{
+    const char *text = value ? value : "";
+    size_t len = strlen(text);
+    hid_t type = H5Tcopy(H5T_C_S1);
+    herr_t rc = type < 0 || H5Tset_size(type, len ? len : 1) < 0 ||
+                        H5Tset_cset(type, H5T_CSET_UTF8) < 0 ||
+                        H5Tset_strpad(type, H5T_STR_NULLPAD) < 0
+                    ? -1
+                    : 0;
+    htri_t exists = rc < 0 ? -1 : H5Aexists(obj, name);
+    if (exists < 0)
+        rc = -1;
+    if (exists > 0) {
+        /* Another length (or a variable-length attribute of an older file): replace it. */
+        hid_t attr = H5Aopen(obj, name, H5P_DEFAULT);
+        hid_t old = attr < 0 ? H5I_INVALID_HID : H5Aget_type(attr);
+        int same = old >= 0 && H5Tequal(old, type) > 0;
+        CLOSE_IDS(0, old, attr);
+        if (!same && H5Adelete(obj, name) < 0)
+            rc = -1;
+    }
+    if (rc >= 0)
+        rc = write_attr(obj, name, type, type, text);
     CLOSE_IDS(rc, type);
     return rc;
 }
@@ -323,6 +372,34 @@ static const series_def SERIES[N_SERIES] = {
     "mode transitions: time, block (0-based), from/to mode (stick 0, slip+ 1, slip- -1), " \
     "position, velocity after the transition, applied spring force"
 
+/* Whether a run with these output fields and friction states writes this series: the one
+ * rule behind both the layout and the list of datasets a reader must find. */
+static int series_selected(const series_def *def, unsigned fields, size_t n_state)
+{
+    if (def->field && !(fields & def->field))
+        return 0;
+    return def->shape != SHAPE_TS || n_state > 0;
+}
+
+/* The datasets a run of this config writes, comma-separated (recorded in the root attribute
+ * "datasets" so that a check needs no config to know what must be there).  Fits in
+ * DATASET_LIST_LEN. */
+#define DATASET_LIST_LEN 256
+static void layout_names(unsigned fields, size_t n_state, int transitions, char *buf,
+                         size_t len)
+{
+    size_t used = 0;
+    buf[0] = '\0';
+    for (int i = 0; i < N_SERIES; ++i)
+        if (series_selected(&SERIES[i], fields, n_state)) {
+            int n = snprintf(buf + used, len - used, "%s%s", used ? "," : "", SERIES[i].name);
+            if (n > 0 && (size_t)n < len - used)
+                used += (size_t)n;
+        }
+    if (transitions)
+        snprintf(buf + used, len - used, "%stransitions", used ? "," : "");
+}
+
 static hid_t kind_file_type(enum series_kind kind)
 {
     switch (kind) {
@@ -438,6 +515,9 @@ struct bk_h5_writer {
     bk_transition *trans_buf;
     size_t trans_buffered;
     hsize_t trans_written;
+    double trans_last_t; /* t of the last transition on disk */
+    long long cp_sequence; /* of the last checkpoint written (0: none) */
+    int cp_slot;         /* slot of /checkpoint the next checkpoint goes to */
     int failed;          /* a write failed: rows on disk may be ragged, accept no more */
 };
 
@@ -494,6 +574,10 @@ static hid_t create_extendable(hid_t file, const char *name, hid_t type, int ran
     if (DEFLATE_LEVEL > 0 && H5Zfilter_avail(H5Z_FILTER_DEFLATE) > 0 &&
         (H5Pset_shuffle(dcpl) < 0 || H5Pset_deflate(dcpl, DEFLATE_LEVEL) < 0))
         goto done;
+    /* A checksum per chunk: bytes damaged on disk make the read fail instead of returning
+     * plausible numbers, and `bksim info` reads every chunk. */
+    if (H5Pset_fletcher32(dcpl) < 0)
+        goto done;
     dset = H5Dcreate2(file, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
 done:
     CLOSE_IDS(dset, dcpl, space);
@@ -505,6 +589,14 @@ static herr_t describe(hid_t obj, const char *units, const char *description)
     if (write_string_attr(obj, "units", units) < 0)
         return -1;
     return write_string_attr(obj, "description", description);
+}
+
+/* The same for objects written after the file was created (see write_fixed_string_attr). */
+static herr_t describe_fixed(hid_t obj, const char *units, const char *description)
+{
+    if (write_fixed_string_attr(obj, "units", units) < 0)
+        return -1;
+    return write_fixed_string_attr(obj, "description", description);
 }
 
 /* Which block each friction-state column belongs to (-1 when no block claims it). */
@@ -579,6 +671,10 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
     if (stored >= 0)
         stored = write_string_attr(w->file, "overrides", overrides);
     free(overrides);
+    char names[DATASET_LIST_LEN];
+    layout_names(fields, n_state, config->output.transitions, names, sizeof names);
+    if (stored >= 0)
+        stored = write_string_attr(w->file, "datasets", names);
     if (stored < 0)
         return H5_FAIL(err, "%s: cannot write root attributes", w->part);
 
@@ -589,9 +685,7 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
     for (int i = 0; i < N_SERIES; ++i) {
         const series_def *def = &SERIES[i];
         series *s = &w->s[i];
-        if (def->field && !(fields & def->field))
-            continue;
-        if (def->shape == SHAPE_TS && n_state == 0)
+        if (!series_selected(def, fields, n_state))
             continue;
         s->rank = def->shape == SHAPE_T ? 1 : 2;
         s->cols = def->shape == SHAPE_T ? 1 : def->shape == SHAPE_TN ? model->n_blocks : n_state;
@@ -627,6 +721,10 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
         if (describe(w->trans_dset, TRANSITIONS_UNITS, TRANSITIONS_DESCRIPTION) < 0)
             return H5_FAIL(err, "%s: cannot write attributes of /transitions", w->part);
     }
+    /* The variable-length strings above go to disk now, once: nothing rewrites them later
+     * (see write_fixed_string_attr). */
+    if (H5Fflush(w->file, H5F_SCOPE_LOCAL) < 0)
+        return H5_FAIL(err, "%s: cannot flush", w->part);
     return BK_OK;
 }
 
@@ -747,6 +845,7 @@ static int flush_transitions(bk_h5_writer *w, bk_error *err)
         return H5_FAIL(err, "%s: cannot append to /transitions", w->part);
     }
     w->trans_written += w->trans_buffered;
+    w->trans_last_t = w->trans_buf[w->trans_buffered - 1].t;
     w->trans_buffered = 0;
     return BK_OK;
 }
@@ -844,7 +943,110 @@ static int sink_transition(void *self, const bk_transition *transition, bk_error
 
 /* ------------------------------------------------------------------- checkpoints --- */
 
+/* A checkpoint has to survive a crash while the next one is written.  HDF5 writes raw data
+ * when asked but keeps attributes in its metadata cache until a flush, so a checkpoint
+ * overwritten in place could be left half old, half new (seen: the attributes of t = 5.88 s
+ * with the positions of t = 5.89 s, and a restart that went on from that mix).  So /checkpoint
+ * holds two slots, /checkpoint/a and /checkpoint/b, written in turn: while one is written the
+ * other is the last complete checkpoint, untouched on disk.  Each slot records a sequence
+ * number and a checksum over everything a restart uses; a restart takes the newest slot that
+ * verifies and agrees with the datasets, and refuses when none does.  A slot is overwritten
+ * in place rather than created anew and linked in, so that writing one changes no link of
+ * the root group and frees no space the other one still occupies; its text is fixed-length
+ * (see write_fixed_string_attr). */
+static const char *const SLOT_NAMES[2] = {"a", "b"};
+
+typedef struct checkpoint_record {
+    long long sequence;        /* 1 for a run's first checkpoint */
+    long long rows;            /* rows of every time series at the checkpoint */
+    long long transition_rows;
+    double last_transition_t;  /* s, t of /transitions[transition_rows - 1]; 0 without */
+} checkpoint_record;
+
+/* FNV-1a (64 bit) over values in little-endian byte order, so a file copied to a machine of
+ * the other byte order still verifies. */
+#define FNV_OFFSET UINT64_C(14695981039346656037)
+#define FNV_PRIME UINT64_C(1099511628211)
+
+static uint64_t hash_u64(uint64_t h, uint64_t v)
+{
+    for (unsigned k = 0; k < 8; ++k) {
+        h ^= (v >> (8 * k)) & 0xffu;
+        h *= FNV_PRIME;
+    }
+    return h;
+}
+
+static uint64_t hash_f64(uint64_t h, double v)
+{
+    uint64_t bits;
+    memcpy(&bits, &v, sizeof bits);
+    return hash_u64(h, bits);
+}
+
+static uint64_t hash_bytes(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < n; ++i) {
+        h ^= (uint64_t)p[i];
+        h *= FNV_PRIME;
+    }
+    return h;
+}
+
+/* Everything a restart reads from a slot, and where the datasets stood. */
+static uint64_t checkpoint_hash(const bk_checkpoint *cp, const checkpoint_record *rec)
+{
+    size_t n = cp->n_blocks, n_state = cp->n_state;
+    uint64_t h = FNV_OFFSET;
+    h = hash_u64(h, (uint64_t)rec->sequence);
+    h = hash_u64(h, (uint64_t)rec->rows);
+    h = hash_u64(h, (uint64_t)rec->transition_rows);
+    h = hash_f64(h, rec->last_transition_t);
+    h = hash_u64(h, (uint64_t)n);
+    h = hash_u64(h, (uint64_t)n_state);
+    h = hash_bytes(h, cp->mode, n);
+    h = hash_bytes(h, cp->from_rest, n);
+    h = hash_bytes(h, cp->extremum_armed, n);
+    for (size_t i = 0; i < n; ++i)
+        h = hash_f64(h, cp->x[i]);
+    for (size_t i = 0; i < n; ++i)
+        h = hash_f64(h, cp->v[i]);
+    for (size_t i = 0; i < n; ++i)
+        h = hash_f64(h, cp->t_switch[i]);
+    for (size_t i = 0; i < n; ++i)
+        h = hash_f64(h, cp->last_transition[i]);
+    for (size_t i = 0; i < n; ++i)
+        h = hash_u64(h, (uint64_t)cp->instant_count[i]);
+    for (size_t k = 0; k < n_state; ++k)
+        h = hash_f64(h, cp->state[k]);
+    h = hash_f64(h, cp->t);
+    h = hash_f64(h, cp->work_driver);
+    h = hash_f64(h, cp->dissipation);
+    h = hash_f64(h, cp->elastic_initial);
+    h = hash_f64(h, cp->kinetic_initial);
+    h = hash_f64(h, cp->t_last_row);
+    h = hash_u64(h, (uint64_t)cp->next_sample);
+    h = hash_u64(h, (uint64_t)cp->steps_since_row);
+    for (size_t i = 0; i < N_STATS; ++i) {
+        const char *field = (const char *)&cp->stats + STATS[i].offset;
+        if (STATS[i].is_long) {
+            long value;
+            memcpy(&value, field, sizeof value);
+            h = hash_u64(h, (uint64_t)value);
+        } else {
+            double value;
+            memcpy(&value, field, sizeof value);
+            h = hash_f64(h, value);
+        }
+    }
+    /* The method as read back: at most sizeof - 1 characters. */
+    return hash_bytes(h, cp->stats.method, strnlen(cp->stats.method, sizeof cp->stats.method - 1));
+}
+
 static herr_t write_stats(hid_t file, const bk_run_stats *stats);
+static herr_t read_block_xfer(hid_t dset, int rank, hsize_t start, hsize_t count, hsize_t col,
+                              hsize_t ncols, hid_t mem_type, void *buf, hid_t dxpl);
 
 /* A fixed 1-D array in group, created on first use and overwritten in place after. */
 static herr_t put_array(hid_t group, const char *name, hid_t file_type, hid_t mem_type, size_t n,
@@ -878,6 +1080,17 @@ static herr_t get_array(hid_t group, const char *name, hid_t mem_type, size_t n,
     return rc;
 }
 
+/* The group name in parent, created when missing; *created tells which. */
+static hid_t open_or_create_group(hid_t parent, const char *name, int *created)
+{
+    htri_t exists = H5Lexists(parent, name, H5P_DEFAULT);
+    *created = exists == 0;
+    if (exists < 0)
+        return H5I_INVALID_HID;
+    return exists ? H5Gopen2(parent, name, H5P_DEFAULT)
+                  : H5Gcreate2(parent, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+}
+
 #define CHECKPOINT_ARRAYS(X)                                                               \
     X("mode", H5T_STD_I8LE, H5T_NATIVE_INT8, n, mode)                                       \
     X("x", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, x)                                         \
@@ -894,7 +1107,11 @@ static herr_t get_array(hid_t group, const char *name, hid_t mem_type, size_t n,
     X("elastic_initial", elastic_initial) X("kinetic_initial", kinetic_initial)            \
     X("t_last_row", t_last_row)
 
-/* Rows up to the checkpoint are flushed first, so a restart truncates to what is on disk. */
+#define CHECKPOINT_UNITS                                                                   \
+    "t: s, x: m, v: m/s, t_switch: s, last_transition: s, energies: J, t_last_row: s, "    \
+    "last_transition_t: s"
+
+/* Rows up to the checkpoint are flushed first, so the row counts it records are on disk. */
 static int sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
 {
     bk_h5_writer *w = self;
@@ -904,10 +1121,21 @@ static int sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
     if (rc != BK_OK)
         return rc;
     size_t n = cp->n_blocks;
-    hid_t group = H5Lexists(w->file, "checkpoint", H5P_DEFAULT) > 0
-                      ? H5Gopen2(w->file, "checkpoint", H5P_DEFAULT)
-                      : H5Gcreate2(w->file, "checkpoint", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    herr_t ok = group < 0 ? -1 : 0;
+    checkpoint_record rec = {w->cp_sequence + 1, (long long)w->rows_written,
+                             (long long)w->trans_written, w->trans_last_t};
+    uint64_t checksum = checkpoint_hash(cp, &rec);
+    int created = 0, slot_created = 0;
+    hid_t top = open_or_create_group(w->file, "checkpoint", &created);
+    herr_t ok = top < 0 ? -1 : 0;
+    if (ok >= 0 && created)
+        ok = describe_fixed(top, "a, b: checkpoint slots",
+                            "the state a restart (bksim run --restart) continues from: two "
+                            "slots written in turn, the newest that verifies (sequence, "
+                            "checksum) is used");
+    hid_t group = ok < 0 ? H5I_INVALID_HID
+                         : open_or_create_group(top, SLOT_NAMES[w->cp_slot], &slot_created);
+    if (group < 0)
+        ok = -1;
 #define PUT(name, file_type, mem_type, count, field)                                       \
     if (ok >= 0)                                                                           \
         ok = put_array(group, name, file_type, mem_type, count, cp->field);
@@ -923,19 +1151,33 @@ static int sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
     if (ok >= 0)
         ok = write_long_attr(group, "steps_since_row", cp->steps_since_row);
     if (ok >= 0)
-        ok = write_long_attr(group, "rows", (long long)w->rows_written);
+        ok = write_long_attr(group, "n_blocks", (long long)n);
     if (ok >= 0)
-        ok = write_long_attr(group, "transition_rows", (long long)w->trans_written);
+        ok = write_long_attr(group, "n_state", (long long)cp->n_state);
+    if (ok >= 0)
+        ok = write_long_attr(group, "rows", rec.rows);
+    if (ok >= 0)
+        ok = write_long_attr(group, "transition_rows", rec.transition_rows);
+    if (ok >= 0)
+        ok = write_double_attr(group, "last_transition_t", rec.last_transition_t);
+    if (ok >= 0)
+        ok = write_long_attr(group, "sequence", rec.sequence);
     if (ok >= 0)
         ok = write_stats(group, &cp->stats);
     if (ok >= 0)
-        ok = describe(group, "t: s, x: m, v: m/s, t_switch: s, last_transition: s, energies: J",
-                      "the state a restart (bksim run --restart) continues from");
-    CLOSE_IDS(ok, group);
+        ok = write_attr(group, "checksum", H5T_STD_U64LE, H5T_NATIVE_UINT64, &checksum);
+    if (ok >= 0 && slot_created)
+        ok = describe_fixed(group, CHECKPOINT_UNITS,
+                            "one checkpoint; checksum: FNV-1a over sequence, rows, "
+                            "transition_rows, last_transition_t, the arrays, the scalars and "
+                            "stats");
+    CLOSE_IDS(ok, group, top);
     if (ok < 0 || H5Fflush(w->file, H5F_SCOPE_LOCAL) < 0) {
         w->failed = 1;
-        return H5_FAIL(err, "%s: cannot write /checkpoint", w->part);
+        return H5_FAIL(err, "%s: cannot write /checkpoint/%s", w->part, SLOT_NAMES[w->cp_slot]);
     }
+    w->cp_sequence = rec.sequence;
+    w->cp_slot ^= 1;
     return BK_OK;
 }
 
@@ -965,17 +1207,130 @@ static herr_t read_stats(hid_t group, bk_run_stats *stats)
     return rc;
 }
 
-static int read_checkpoint(hid_t file, const char *path, const bk_config *config, bk_checkpoint *cp,
-                           hsize_t *rows, hsize_t *transition_rows, bk_error *err)
+/* A dataset transfer that skips Fletcher32 checks; H5P_DEFAULT-like otherwise. */
+static hid_t unchecked_xfer(void)
 {
-    if (H5Lexists(file, "checkpoint", H5P_DEFAULT) <= 0)
-        return BK_FAIL(err, BK_ERR_INVALID, "%s: no checkpoint to restart from (run with [output] "
-                       "checkpoint_interval > 0)", path);
-    size_t n = config->model->n_blocks;
-    if (bk_checkpoint_alloc(cp, n, config->model->n_friction_state) != BK_OK)
-        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
-    hid_t group = H5Gopen2(file, "checkpoint", H5P_DEFAULT);
-    herr_t ok = group < 0 ? -1 : 0;
+    hid_t dxpl = H5Pcreate(H5P_DATASET_XFER);
+    if (dxpl >= 0 && H5Pset_edc_check(dxpl, H5Z_DISABLE_EDC) < 0) {
+        CLOSE_IDS(-1, dxpl);
+        return H5I_INVALID_HID;
+    }
+    return dxpl;
+}
+
+/* Rows [start, start + count) of a dataset, reading a chunk whose checksum fails as it is;
+ * *unchecked (may be NULL) tells whether that was needed.  Only for the chunk at a
+ * checkpoint's last row: a run killed while appending to that chunk may have left it half
+ * rewritten, and both versions hold the same bytes in the rows up to the checkpoint, so those
+ * rows are intact even though the chunk's checksum is not. */
+static herr_t read_rows_lenient(hid_t dset, int rank, hsize_t start, hsize_t count, hsize_t cols,
+                                hid_t mem_type, void *buf, int *unchecked)
+{
+    if (unchecked)
+        *unchecked = 0;
+    if (read_block_xfer(dset, rank, start, count, 0, cols, mem_type, buf, H5P_DEFAULT) >= 0)
+        return 0;
+    if (unchecked)
+        *unchecked = 1;
+    hid_t dxpl = unchecked_xfer();
+    herr_t rc = dxpl < 0 ? -1 : read_block_xfer(dset, rank, start, count, 0, cols, mem_type, buf, dxpl);
+    CLOSE_IDS(rc, dxpl);
+    return rc;
+}
+
+/* Length of a dataset's first dimension; -1 when it cannot be read. */
+static long long leading_dim(hid_t dset)
+{
+    hid_t space = H5Dget_space(dset);
+    hsize_t dims[2] = {0, 0};
+    int rank = space < 0 ? -1 : H5Sget_simple_extent_dims(space, dims, NULL);
+    CLOSE_IDS(rank, space);
+    return rank < 1 ? -1 : (long long)dims[0];
+}
+
+/* The checkpoint agrees with the datasets: the rows it counts are there and the last of them
+ * is the row it records.  Returns 0, or -1 with why filled. */
+static int slot_matches_data(hid_t file, const bk_checkpoint *cp, const checkpoint_record *rec,
+                             char *why, size_t why_len)
+{
+    hid_t time = H5Lexists(file, "time", H5P_DEFAULT) > 0 ? H5Dopen2(file, "time", H5P_DEFAULT)
+                                                          : H5I_INVALID_HID;
+    long long rows = time < 0 ? -1 : leading_dim(time);
+    double t = NAN;
+    int rc = 0;
+    if (rows < 0) {
+        snprintf(why, why_len, "/time cannot be read");
+        rc = -1;
+    } else if (rows < rec->rows) {
+        snprintf(why, why_len, "records %lld rows, /time has %lld", rec->rows, rows);
+        rc = -1;
+    } else if (rec->rows > 0 &&
+               (read_rows_lenient(time, 1, (hsize_t)(rec->rows - 1), 1, 1, H5T_NATIVE_DOUBLE, &t, NULL) < 0 ||
+                t != cp->t_last_row)) {
+        snprintf(why, why_len, "its last row is at t = %.17g s, /time[%lld] = %.17g s",
+                 cp->t_last_row, rec->rows - 1, t);
+        rc = -1;
+    }
+    close_id(time);
+    if (rc < 0 || rec->transition_rows == 0)
+        return rc;
+    hid_t table = H5Lexists(file, "transitions", H5P_DEFAULT) > 0
+                      ? H5Dopen2(file, "transitions", H5P_DEFAULT)
+                      : H5I_INVALID_HID;
+    hid_t mem = table < 0 ? H5I_INVALID_HID : transition_type(0);
+    long long count = mem < 0 ? -1 : leading_dim(table);
+    bk_transition last;
+    last.t = NAN;
+    if (count < rec->transition_rows) {
+        snprintf(why, why_len, "records %lld transitions, /transitions has %lld",
+                 rec->transition_rows, count < 0 ? 0 : count);
+        rc = -1;
+    } else if (read_rows_lenient(table, 1, (hsize_t)(rec->transition_rows - 1), 1, 1, mem, &last, NULL) < 0 ||
+               last.t != rec->last_transition_t) {
+        snprintf(why, why_len, "its last transition is at t = %.17g s, /transitions[%lld] at %.17g s",
+                 rec->last_transition_t, rec->transition_rows - 1, last.t);
+        rc = -1;
+    }
+    CLOSE_IDS(0, mem, table);
+    return rc;
+}
+
+/* Read one slot of /checkpoint into cp (allocated here; freed again unless BK_OK) and check
+ * it: its sizes (n_state SIZE_MAX: any), its checksum and its agreement with the datasets.
+ * BK_OK; BK_ERR_NOMEM; or BK_ERR_DAMAGED with why filled (no path: the caller adds it). */
+static int read_slot(hid_t file, hid_t top, const char *name, size_t n_blocks, size_t n_state,
+                     bk_checkpoint *cp, checkpoint_record *rec, char *why, size_t why_len)
+{
+    memset(cp, 0, sizeof *cp);
+    memset(rec, 0, sizeof *rec);
+    if (H5Lexists(top, name, H5P_DEFAULT) <= 0) {
+        snprintf(why, why_len, "not written");
+        return BK_ERR_DAMAGED;
+    }
+    hid_t group = H5Gopen2(top, name, H5P_DEFAULT);
+    long long nb = -1, ns = -1;
+    if (group < 0 || read_numeric_attr(group, "n_blocks", H5T_NATIVE_LLONG, &nb) < 0 ||
+        read_numeric_attr(group, "n_state", H5T_NATIVE_LLONG, &ns) < 0) {
+        CLOSE_IDS(-1, group);
+        snprintf(why, why_len, "cannot be read (written only in part)");
+        return BK_ERR_DAMAGED;
+    }
+    /* The counts size the arrays, so they are checked before the checksum can be. */
+    int fits = nb == (long long)n_blocks && ns >= 0 && ns <= (long long)(SIZE_MAX / 64) &&
+               (n_state == SIZE_MAX || ns == (long long)n_state);
+    if (!fits) {
+        CLOSE_IDS(0, group);
+        snprintf(why, why_len, "holds %lld blocks and %lld friction states, the run %zu blocks", nb, ns,
+                 n_blocks);
+        return BK_ERR_DAMAGED;
+    }
+    size_t n = n_blocks;
+    if (bk_checkpoint_alloc(cp, n, (size_t)ns) != BK_OK) {
+        CLOSE_IDS(0, group);
+        snprintf(why, why_len, "out of memory");
+        return BK_ERR_NOMEM;
+    }
+    herr_t ok = 0;
 #define GET(name, file_type, mem_type, count, field)                                       \
     if (ok >= 0)                                                                           \
         ok = get_array(group, name, mem_type, count, cp->field);
@@ -986,48 +1341,221 @@ static int read_checkpoint(hid_t file, const char *path, const bk_config *config
         ok = read_numeric_attr(group, name, H5T_NATIVE_DOUBLE, &cp->field);
     CHECKPOINT_SCALARS(GET)
 #undef GET
-    long long next_sample = 0, steps = 0, r = 0, tr = 0;
+    long long next_sample = 0, steps = 0;
+    uint64_t stored = 0;
     if (ok >= 0)
         ok = read_numeric_attr(group, "next_sample", H5T_NATIVE_LLONG, &next_sample);
     if (ok >= 0)
         ok = read_numeric_attr(group, "steps_since_row", H5T_NATIVE_LLONG, &steps);
     if (ok >= 0)
-        ok = read_numeric_attr(group, "rows", H5T_NATIVE_LLONG, &r);
+        ok = read_numeric_attr(group, "rows", H5T_NATIVE_LLONG, &rec->rows);
     if (ok >= 0)
-        ok = read_numeric_attr(group, "transition_rows", H5T_NATIVE_LLONG, &tr);
+        ok = read_numeric_attr(group, "transition_rows", H5T_NATIVE_LLONG, &rec->transition_rows);
+    if (ok >= 0)
+        ok = read_numeric_attr(group, "last_transition_t", H5T_NATIVE_DOUBLE, &rec->last_transition_t);
+    if (ok >= 0)
+        ok = read_numeric_attr(group, "sequence", H5T_NATIVE_LLONG, &rec->sequence);
     if (ok >= 0)
         ok = read_stats(group, &cp->stats);
+    if (ok >= 0)
+        ok = read_numeric_attr(group, "checksum", H5T_NATIVE_UINT64, &stored);
     CLOSE_IDS(ok, group);
-    if (ok < 0) {
-        bk_checkpoint_free(cp);
-        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /checkpoint cannot be read", path);
-    }
     cp->next_sample = (long)next_sample;
     cp->steps_since_row = (long)steps;
-    *rows = (hsize_t)r;
-    *transition_rows = (hsize_t)tr;
+    int rc = BK_OK;
+    if (ok < 0) {
+        snprintf(why, why_len, "cannot be read (written only in part)");
+        rc = BK_ERR_DAMAGED;
+    } else if (checkpoint_hash(cp, rec) != stored) {
+        snprintf(why, why_len, "checksum mismatch (written only in part, or altered)");
+        rc = BK_ERR_DAMAGED;
+    } else if (rec->rows < 0 || rec->transition_rows < 0 ||
+               slot_matches_data(file, cp, rec, why, why_len) < 0) {
+        if (rec->rows < 0 || rec->transition_rows < 0)
+            snprintf(why, why_len, "negative row counts");
+        rc = BK_ERR_DAMAGED;
+    }
+    if (rc != BK_OK)
+        bk_checkpoint_free(cp);
+    return rc;
+}
+
+/* The newest slot of /checkpoint that verifies, into cp; *slot says which.  BK_ERR_INVALID
+ * when the file has no /checkpoint; BK_ERR_DAMAGED when no slot verifies (the message gives
+ * each slot's fault), or when /checkpoint was written without a consistency record (*legacy
+ * set: an older bksim's, which cannot be verified). */
+static int find_checkpoint(hid_t file, const char *path, size_t n_blocks, size_t n_state,
+                           bk_checkpoint *cp, checkpoint_record *rec, int *slot, int *legacy,
+                           bk_error *err)
+{
+    memset(cp, 0, sizeof *cp);
+    *legacy = 0;
+    if (H5Lexists(file, "checkpoint", H5P_DEFAULT) <= 0)
+        return BK_FAIL(err, BK_ERR_INVALID, "%s: no checkpoint to restart from (run with [output] "
+                       "checkpoint_interval > 0)", path);
+    hid_t top = H5Gopen2(file, "checkpoint", H5P_DEFAULT);
+    if (top < 0)
+        return H5_DAMAGED(err, "%s: damaged: /checkpoint cannot be opened", path);
+    if (H5Lexists(top, "x", H5P_DEFAULT) > 0) {
+        *legacy = 1;
+        close_id(top);
+        return BK_FAIL(err, BK_ERR_DAMAGED,
+                       "%s: /checkpoint was written by an older bksim without a consistency "
+                       "record, so it cannot be verified; not restarting from it (run again "
+                       "from the start)", path);
+    }
+    bk_checkpoint found[2];
+    checkpoint_record recs[2];
+    char why[2][200];
+    int status[2];
+    for (int k = 0; k < 2; ++k)
+        status[k] = read_slot(file, top, SLOT_NAMES[k], n_blocks, n_state, &found[k], &recs[k],
+                              why[k], sizeof why[k]);
+    close_id(top);
+    int best = -1;
+    for (int k = 0; k < 2; ++k)
+        if (status[k] == BK_OK && (best < 0 || recs[k].sequence > recs[best].sequence))
+            best = k;
+    for (int k = 0; k < 2; ++k)
+        if (k != best && status[k] == BK_OK)
+            bk_checkpoint_free(&found[k]);
+    if (best < 0) {
+        if (status[0] == BK_ERR_NOMEM || status[1] == BK_ERR_NOMEM)
+            return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory reading /checkpoint", path);
+        return BK_FAIL(err, BK_ERR_DAMAGED,
+                       "%s: damaged: no checkpoint verifies, so a restart would continue from "
+                       "an inconsistent state (/checkpoint/a: %s; /checkpoint/b: %s)",
+                       path, why[0], why[1]);
+    }
+    *cp = found[best];
+    *rec = recs[best];
+    *slot = best;
     return BK_OK;
 }
 
-/* Truncate dset to rows (dropping what was written after the checkpoint). */
-static herr_t truncate_rows(hid_t dset, hsize_t rows)
+/* First-dimension chunk size of a chunked dataset; 0 when not chunked. */
+static hsize_t chunk_rows_of(hid_t dset)
+{
+    hid_t dcpl = H5Dget_create_plist(dset);
+    hsize_t chunk[2] = {0, 0};
+    if (dcpl < 0 || H5Pget_layout(dcpl) != H5D_CHUNKED || H5Pget_chunk(dcpl, 2, chunk) < 1)
+        chunk[0] = 0;
+    CLOSE_IDS(0, dcpl);
+    return chunk[0];
+}
+
+/* Truncate dset to rows, dropping what was written after the checkpoint.  When the chunk
+ * holding the last of those rows fails its checksum (see read_rows_lenient), its rows up to
+ * the checkpoint are first written back over it, checks off for the read that write makes,
+ * so that it is whole again.  The chunk is rewritten in place, never dropped and written
+ * anew: a kill between dropping it and flushing its replacement could lose it from the
+ * chunk index, and its rows would read back as zeros. */
+static herr_t truncate_rows(hid_t dset, hsize_t rows, hid_t mem_type, size_t row_bytes)
 {
     hid_t space = H5Dget_space(dset);
     hsize_t dims[2] = {0, 0};
     int rank = space < 0 ? -1 : H5Sget_simple_extent_dims(space, dims, NULL);
     CLOSE_IDS(rank, space);
-    if (rank < 1 || dims[0] < rows)
+    if (rank < 1 || rank > 2 || dims[0] < rows)
         return -1;
+    hsize_t chunk = chunk_rows_of(dset);
+    hsize_t start = chunk > 0 ? rows / chunk * chunk : rows;
+    herr_t rc = 0;
+    if (start < rows) {
+        hsize_t count = rows - start;
+        void *buf = malloc((size_t)count * row_bytes);
+        int unchecked = 0;
+        rc = buf ? read_rows_lenient(dset, rank, start, count, dims[1], mem_type, buf, &unchecked) : -1;
+        if (rc >= 0 && unchecked) {
+            hsize_t offset[2] = {start, 0}, counts[2] = {count, dims[1]};
+            hid_t file_space = H5Dget_space(dset);
+            hid_t mem_space = H5Screate_simple(rank, counts, NULL);
+            hid_t dxpl = unchecked_xfer();
+            rc = file_space < 0 || mem_space < 0 || dxpl < 0 ||
+                         H5Sselect_hyperslab(file_space, H5S_SELECT_SET, offset, NULL, counts, NULL) < 0
+                     ? -1
+                     : H5Dwrite(dset, mem_type, mem_space, file_space, dxpl, buf);
+            CLOSE_IDS(rc, dxpl, mem_space, file_space);
+        }
+        free(buf);
+    }
     dims[0] = rows;
-    return H5Dset_extent(dset, dims);
+    return rc < 0 ? rc : H5Dset_extent(dset, dims);
+}
+
+/* The config a run stored (file text and --set overrides, any number of them). */
+static int load_stored_config(hid_t file, const char *path, bk_config **config, bk_error *err)
+{
+    *config = NULL;
+    char *text = read_string_attr(file, "config_file");
+    char *name = read_string_attr(file, "config_name");
+    char *overrides = read_string_attr(file, "overrides");
+    const char **list = NULL;
+    size_t n_over = 0, cap = 0;
+    int rc = BK_OK;
+    if (!text || !name)
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: no stored config to restart with", path);
+    char *save = NULL;
+    for (char *line = rc == BK_OK && overrides ? strtok_r(overrides, "\n", &save) : NULL; line;
+         line = strtok_r(NULL, "\n", &save)) {
+        if (n_over == cap) {
+            size_t grown_cap = cap ? 2 * cap : 16;
+            const char **grown = realloc(list, grown_cap * sizeof *grown);
+            if (!grown) {
+                rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for the stored overrides", path);
+                break;
+            }
+            list = grown;
+            cap = grown_cap;
+        }
+        list[n_over++] = line;
+    }
+    if (rc == BK_OK)
+        rc = bk_config_load_string(text, name, list, n_over, config, err);
+    free(list);
+    free(text);
+    free(name);
+    free(overrides);
+    return rc;
+}
+
+/* The datasets the writer created, from the root attribute "datasets"; NULL for a file
+ * written before it was recorded.  Malloc'ed, comma-separated. */
+static char *recorded_datasets(hid_t file)
+{
+    return read_string_attr(file, "datasets");
+}
+
+/* Every name in the comma-separated list is a link in file; else BK_ERR_DAMAGED. */
+static int require_datasets(hid_t file, const char *path, const char *names, bk_error *err)
+{
+    for (const char *p = names; p && *p;) {
+        const char *end = strchr(p, ',');
+        size_t len = end ? (size_t)(end - p) : strlen(p);
+        char name[64];
+        if (len > 0 && len < sizeof name) {
+            memcpy(name, p, len);
+            name[len] = '\0';
+            if (H5Lexists(file, name, H5P_DEFAULT) <= 0)
+                return BK_FAIL(err, BK_ERR_DAMAGED,
+                               "%s: damaged: no /%s, which the run wrote (root attribute "
+                               "datasets: %s)", path, name, names);
+        }
+        p = end ? end + 1 : p + len;
+    }
+    return BK_OK;
 }
 
 int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config_out,
                         bk_checkpoint *checkpoint, bk_error *err)
 {
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    if (!out || !path || !config_out || !checkpoint)
+        return BK_FAIL(err, BK_ERR_INVALID,
+                       "bk_h5_writer_resume: needs writer, path, config and checkpoint pointers");
     *out = NULL;
     *config_out = NULL;
+    memset(checkpoint, 0, sizeof *checkpoint);
     size_t len = strlen(path);
     int is_part = len > 5 && strcmp(path + len - 5, ".part") == 0;
     bk_h5_writer *w = calloc(1, sizeof *w);
@@ -1058,28 +1586,41 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
     }
     bk_config *config = NULL;
     bk_checkpoint *cp = checkpoint;
-    memset(cp, 0, sizeof *cp);
-    hsize_t rows = 0, transition_rows = 0;
+    checkpoint_record rec = {0, 0, 0, 0.0};
+    int slot = 0, legacy = 0;
     w->file = H5Fopen(w->part, H5F_ACC_RDWR, H5P_DEFAULT);
     int rc = w->file < 0 ? H5_FAIL(err, "%s: cannot open for the restart", w->part) : BK_OK;
-    if (rc == BK_OK) {
-        char *text = read_string_attr(w->file, "config_file");
-        char *name = read_string_attr(w->file, "config_name");
-        char *overrides = read_string_attr(w->file, "overrides");
-        const char *list[256];
-        size_t n_over = 0;
-        for (char *line = overrides ? strtok(overrides, "\n") : NULL; line && n_over < 256; line = strtok(NULL, "\n"))
-            list[n_over++] = line;
-        if (!text || !name)
-            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: no stored config to restart with", w->part);
-        else
-            rc = bk_config_load_string(text, name, list, n_over, &config, err);
-        free(text);
-        free(name);
-        free(overrides);
-    }
+    /* HDF5 writes the superblock, which holds the end of allocated space (EOA), last in a
+     * flush; a kill inside a flush can leave blocks written past the EOA it records.  Space
+     * freed there (a chunk dropped by the truncation below) would then be handed out again
+     * and every write to it fail ("addr overflow").  Nothing on disk lies past the end of the
+     * file, so moving the EOA there is safe. */
+    haddr_t eoa = 0;
+    if (rc == BK_OK && H5Fget_eoa(w->file, &eoa) >= 0 && (haddr_t)st.st_size > eoa &&
+        H5Fincrement_filesize(w->file, 0) < 0)
+        rc = H5_FAIL(err, "%s: cannot extend the allocated space to the end of the file", w->part);
+    /* The checkpoint before the config: it needs no variable-length string (see
+     * write_fixed_string_attr), so a file without one is refused without reading any. */
+    long long n_blocks = 0;
+    if (rc == BK_OK && (read_numeric_attr(w->file, "n_blocks", H5T_NATIVE_LLONG, &n_blocks) < 0 ||
+                        n_blocks < 1))
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: no valid root attribute n_blocks", w->part);
     if (rc == BK_OK)
-        rc = read_checkpoint(w->file, w->part, config, cp, &rows, &transition_rows, err);
+        rc = find_checkpoint(w->file, w->part, (size_t)n_blocks, SIZE_MAX, cp, &rec, &slot,
+                             &legacy, err);
+    if (rc == BK_OK)
+        rc = load_stored_config(w->file, w->part, &config, err);
+    if (rc == BK_OK && (config->model->n_blocks != cp->n_blocks ||
+                        config->model->n_friction_state != cp->n_state))
+        rc = BK_FAIL(err, BK_ERR_DAMAGED,
+                     "%s: damaged: the checkpoint holds %zu blocks and %zu friction states, the "
+                     "stored config makes %zu and %zu", w->part, cp->n_blocks, cp->n_state,
+                     config->model->n_blocks, config->model->n_friction_state);
+    if (rc == BK_OK) {
+        char *names = recorded_datasets(w->file);
+        rc = require_datasets(w->file, w->part, names, err);
+        free(names);
+    }
     if (rc == BK_OK) {
         const bk_model *model = config->model;
         size_t n_state = model->n_friction_state;
@@ -1087,6 +1628,7 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
         size_t buffer_rows = CHUNK_BYTES / (widest * sizeof(double));
         w->buffer_rows = buffer_rows < 1 ? 1 : buffer_rows > MAX_BUFFER_ROWS ? MAX_BUFFER_ROWS : buffer_rows;
         w->n_blocks = model->n_blocks;
+        hsize_t rows = (hsize_t)rec.rows;
         for (int i = 0; rc == BK_OK && i < N_SERIES; ++i) {
             series *ser = &w->s[i];
             if (H5Lexists(w->file, SERIES[i].name, H5P_DEFAULT) <= 0)
@@ -1096,7 +1638,8 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
             ser->cols = SERIES[i].shape == SHAPE_T ? 1 : SERIES[i].shape == SHAPE_TN ? model->n_blocks : n_state;
             ser->elem = kind_size(SERIES[i].kind);
             ser->buf = malloc(w->buffer_rows * ser->cols * ser->elem);
-            if (ser->dset < 0 || !ser->buf || truncate_rows(ser->dset, rows) < 0)
+            if (ser->dset < 0 || !ser->buf ||
+                truncate_rows(ser->dset, rows, kind_mem_type(SERIES[i].kind), ser->cols * ser->elem) < 0)
                 rc = H5_FAIL(err, "%s: cannot reopen /%s at the checkpoint's %llu rows", w->part,
                              SERIES[i].name, (unsigned long long)rows);
         }
@@ -1105,12 +1648,17 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
             w->trans_mem = transition_type(0);
             w->trans_dset = H5Dopen2(w->file, "transitions", H5P_DEFAULT);
             if (!w->trans_buf || w->trans_mem < 0 || w->trans_dset < 0 ||
-                truncate_rows(w->trans_dset, transition_rows) < 0)
+                truncate_rows(w->trans_dset, (hsize_t)rec.transition_rows, w->trans_mem,
+                              sizeof(bk_transition)) < 0)
                 rc = H5_FAIL(err, "%s: cannot reopen /transitions at the checkpoint", w->part);
         }
         w->rows_written = rows;
-        w->trans_written = transition_rows;
+        w->trans_written = (hsize_t)rec.transition_rows;
+        w->trans_last_t = rec.last_transition_t;
         w->t_written = w->t_buffered = cp->t_last_row;
+        /* The next checkpoint goes into the other slot: this one stays the fallback. */
+        w->cp_sequence = rec.sequence;
+        w->cp_slot = slot ^ 1;
         if (rc == BK_OK && (write_int_attr(w->file, "complete", 0) < 0 ||
                             write_double_attr(w->file, "t_reached", w->t_written) < 0 ||
                             (H5Aexists(w->file, "error") > 0 && H5Adelete(w->file, "error") < 0)))
@@ -1126,6 +1674,48 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
     *out = w;
     *config_out = config;
     return BK_OK;
+}
+
+int bk_h5_restartable(const char *path, double *t_checkpoint, bk_error *err)
+{
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    if (!path || !*path)
+        return BK_FAIL(err, BK_ERR_INVALID, "bk_h5_restartable: no output path given");
+    size_t len = strlen(path);
+    int is_part = len > 5 && strcmp(path + len - 5, ".part") == 0;
+    char *part = malloc(len + sizeof ".part");
+    if (!part)
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    if (is_part)
+        memcpy(part, path, len + 1);
+    else
+        sprintf(part, "%s.part", path);
+    struct stat st;
+    hid_t file = H5I_INVALID_HID;
+    int result = 0;
+    if (stat(part, &st) == 0 && S_ISREG(st.st_mode) && has_hdf5_signature(part) > 0)
+        file = H5Fopen(part, H5F_ACC_RDONLY, H5P_DEFAULT);
+    long long n_blocks = 0;
+    if (file >= 0 && read_numeric_attr(file, "n_blocks", H5T_NATIVE_LLONG, &n_blocks) >= 0 &&
+        n_blocks > 0 && H5Lexists(file, "checkpoint", H5P_DEFAULT) > 0) {
+        bk_checkpoint cp;
+        checkpoint_record rec;
+        int slot, legacy;
+        bk_error ignored;
+        int found = find_checkpoint(file, part, (size_t)n_blocks, SIZE_MAX, &cp, &rec, &slot,
+                                    &legacy, &ignored);
+        if (found == BK_OK) {
+            if (t_checkpoint)
+                *t_checkpoint = cp.t;
+            bk_checkpoint_free(&cp);
+            result = 1;
+        } else if (found == BK_ERR_NOMEM) {
+            result = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory reading /checkpoint", part);
+        }
+    }
+    close_id(file);
+    free(part);
+    return result;
 }
 
 bk_sink bk_h5_writer_sink(bk_h5_writer *writer)
@@ -1156,7 +1746,7 @@ static herr_t write_stats(hid_t file, const bk_run_stats *stats)
     char method[sizeof stats->method + 1];
     memcpy(method, stats->method, sizeof stats->method);
     method[sizeof stats->method] = '\0';
-    if (write_string_attr(group, "method", method) < 0)
+    if (write_fixed_string_attr(group, "method", method) < 0)
         goto done;
     char units[1024] = "";
     size_t used = 0;
@@ -1179,7 +1769,7 @@ static herr_t write_stats(hid_t file, const bk_run_stats *stats)
         if (n > 0 && (size_t)n < sizeof units - used)
             used += (size_t)n;
     }
-    rc = describe(group, units, "solver statistics of the run");
+    rc = describe_fixed(group, units, "solver statistics of the run");
 done:
     CLOSE_IDS(rc, group, gcpl);
     return rc;
@@ -1195,10 +1785,48 @@ static void mark_incomplete(const char *part, const char *reason)
         return;
     hid_t hold = H5Dopen2(file, "time", H5P_DEFAULT);
     write_int_attr(file, "complete", 0);
-    write_string_attr(file, "error", reason);
+    write_fixed_string_attr(file, "error", reason);
     H5Fclose(file);
     if (hold >= 0)
         H5Dclose(hold);
+}
+
+/* Force a file (or directory) to disk; 0 or an errno.  EINVAL (a file system that cannot
+ * sync, such as some FUSE mounts) passes: there is nothing more to be done. */
+static int sync_path(const char *path)
+{
+    int fd = open(path, O_RDONLY);
+    if (fd < 0)
+        return errno;
+    int e = fsync(fd) == 0 || errno == EINVAL ? 0 : errno;
+    close(fd);
+    return e;
+}
+
+/* The rename of a finished file, made durable: H5Fclose leaves the data in the page cache,
+ * and a power cut after the rename could otherwise leave a complete-looking OUT with
+ * missing chunks.  The directory sync that makes the new name last is best effort. */
+static int durable_rename(const char *part, const char *path, bk_error *err)
+{
+    int e = sync_path(part);
+    if (e != 0)
+        return BK_FAIL(err, BK_ERR_IO, "%s: cannot sync to disk: %s", part, strerror(e));
+    if (rename(part, path) != 0) {
+        e = errno;
+        return BK_FAIL(err, BK_ERR_IO, "%s: cannot rename to %s: %s", part, path, strerror(e));
+    }
+    char *dir = strdup(path);
+    if (dir) {
+        char *slash = strrchr(dir, '/');
+        if (!slash)
+            sync_path(".");
+        else {
+            slash[slash == dir ? 1 : 0] = '\0';
+            sync_path(dir);
+        }
+        free(dir);
+    }
+    return BK_OK;
 }
 
 int bk_h5_writer_finish(bk_h5_writer *writer, const bk_run_stats *stats, bk_error *err)
@@ -1224,11 +1852,8 @@ int bk_h5_writer_finish(bk_h5_writer *writer, const bk_run_stats *stats, bk_erro
     }
     if (close_writer(w) < 0 && rc == BK_OK)
         rc = H5_FAIL(err, "%s: cannot close", w->part);
-    if (rc == BK_OK && rename(w->part, w->path) != 0) {
-        int e = errno;
-        rc = BK_FAIL(err, BK_ERR_IO, "%s: cannot rename to %s: %s", w->part, w->path,
-                     strerror(e));
-    }
+    if (rc == BK_OK)
+        rc = durable_rename(w->part, w->path, err);
     if (rc != BK_OK && marked)
         mark_incomplete(w->part, err ? err->message : "finishing the output failed");
     free_writer(w);
@@ -1249,7 +1874,7 @@ void bk_h5_writer_abandon(bk_h5_writer *writer, const char *reason, const bk_run
         write_stats(w->file, stats);
     write_int_attr(w->file, "complete", 0);
     write_double_attr(w->file, "t_reached", w->t_written);
-    write_string_attr(w->file, "error", reason ? reason : "run abandoned");
+    write_fixed_string_attr(w->file, "error", reason ? reason : "run abandoned");
     close_writer(w);
     free_writer(w);
 }
@@ -1267,11 +1892,7 @@ static int open_input(const char *path, hid_t *file, bk_error *err)
         return BK_FAIL(err, BK_ERR_IO, "%s: %s", path, strerror(errno));
     if (S_ISDIR(st.st_mode))
         return BK_FAIL(err, BK_ERR_IO, "%s: is a directory, not an HDF5 file", path);
-#if H5_VERSION_GE(1, 12, 0)
-    htri_t is_hdf5 = H5Fis_accessible(path, H5P_DEFAULT);
-#else
-    htri_t is_hdf5 = H5Fis_hdf5(path);
-#endif
+    htri_t is_hdf5 = has_hdf5_signature(path);
     if (is_hdf5 == 0)
         return BK_FAIL(err, BK_ERR_HDF5, "%s: not an HDF5 file (no HDF5 signature found)",
                        path);
@@ -1421,9 +2042,10 @@ static int open_series(hid_t file, const char *path, const char *name, hid_t *ds
     return BK_OK;
 }
 
-/* Rows [start, start + count) and columns [col, col + ncols) as doubles. */
-static herr_t read_block(hid_t dset, int rank, hsize_t start, hsize_t count, hsize_t col,
-                         hsize_t ncols, hid_t mem_type, void *buf)
+/* Rows [start, start + count) and columns [col, col + ncols) as mem_type, read with the
+ * transfer properties dxpl. */
+static herr_t read_block_xfer(hid_t dset, int rank, hsize_t start, hsize_t count, hsize_t col,
+                              hsize_t ncols, hid_t mem_type, void *buf, hid_t dxpl)
 {
     hsize_t offset[2] = {start, col};
     hsize_t counts[2] = {count, ncols};
@@ -1434,10 +2056,16 @@ static herr_t read_block(hid_t dset, int rank, hsize_t start, hsize_t count, hsi
         goto done;
     mem_space = H5Screate_simple(rank, counts, NULL);
     if (mem_space >= 0)
-        rc = H5Dread(dset, mem_type, mem_space, file_space, H5P_DEFAULT, buf);
+        rc = H5Dread(dset, mem_type, mem_space, file_space, dxpl, buf);
 done:
     CLOSE_IDS(rc, mem_space, file_space);
     return rc;
+}
+
+static herr_t read_block(hid_t dset, int rank, hsize_t start, hsize_t count, hsize_t col,
+                         hsize_t ncols, hid_t mem_type, void *buf)
+{
+    return read_block_xfer(dset, rank, start, count, col, ncols, mem_type, buf, H5P_DEFAULT);
 }
 
 int bk_h5_read_doubles(const char *path, const char *dataset, double **data, size_t *rows,
@@ -1684,13 +2312,13 @@ static int count_phases(hid_t file, const char *path, size_t n_blocks, long *sti
         if (n > TRANSITION_BUFFER)
             n = TRANSITION_BUFFER;
         if (read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
-            rc = H5_FAIL(err, "%s: cannot read /transitions", path);
+            rc = H5_DAMAGED(err, "%s: damaged: /transitions cannot be read", path);
             break;
         }
         for (size_t k = 0; k < n; ++k) {
             if (buf[k].block < 0 || (size_t)buf[k].block >= n_blocks) {
-                rc = BK_FAIL(err, BK_ERR_HDF5,
-                             "%s: /transitions row %llu names block %d, outside 0..%zu", path,
+                rc = BK_FAIL(err, BK_ERR_DAMAGED,
+                             "%s: damaged: /transitions row %llu names block %d, outside 0..%zu", path,
                              (unsigned long long)(start + k), (int)buf[k].block, n_blocks - 1);
                 break;
             }
@@ -1703,54 +2331,209 @@ static int count_phases(hid_t file, const char *path, size_t n_blocks, long *sti
     return rc;
 }
 
+/* What a check needs to know about the file as a whole. */
+typedef struct verify_ctx {
+    const char *path;
+    long long n_blocks;
+    double t_end, t_reached;
+    int complete;
+} verify_ctx;
+
+/* Rows read at a time while checking: whole chunks (a partial chunk would be read and its
+ * checksum computed once per piece), about EXPORT_BUDGET values. */
+static hsize_t scan_step(hid_t dset, hsize_t cols)
+{
+    hsize_t chunk = chunk_rows_of(dset);
+    if (chunk == 0)
+        chunk = 1;
+    hsize_t chunks = EXPORT_BUDGET / (chunk * (cols ? cols : 1));
+    return chunk * (chunks ? chunks : 1);
+}
+
+/* Every value of one time series, streamed a block of rows at a time: finite, modes and
+ * event flags from their sets, /time strictly increasing up to t_reached (and t_end when
+ * complete).  A chunk failing its checksum fails the read: damaged. */
+static int scan_series(hid_t file, const verify_ctx *v, const char *name, bk_error *err)
+{
+    const char *path = v->path;
+    hid_t dset;
+    hsize_t rows, cols;
+    int rank;
+    if (open_series(file, path, name, &dset, &rows, &cols, &rank, err) != BK_OK)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s cannot be read", path, name);
+    int is_time = strcmp(name, "time") == 0;
+    int is_mode = strcmp(name, "mode") == 0;
+    int is_event = strcmp(name, "event") == 0;
+    hsize_t step = scan_step(dset, cols);
+    if (step > rows)
+        step = rows ? rows : 1;
+    double *buf = malloc((size_t)(step * cols) * sizeof *buf);
+    int rc = buf ? BK_OK : BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    double prev = NAN, before = NAN; /* the value before this one; the block's last */
+    for (hsize_t start = 0; rc == BK_OK && start < rows; start += step) {
+        hsize_t count = rows - start < step ? rows - start : step;
+        if (read_block(dset, rank, start, count, 0, cols, H5T_NATIVE_DOUBLE, buf) < 0) {
+            rc = H5_DAMAGED(err, "%s: damaged: /%s rows %llu..%llu cannot be read", path, name,
+                            (unsigned long long)start, (unsigned long long)(start + count - 1));
+            break;
+        }
+        size_t values = (size_t)(count * cols);
+        for (size_t k = 0; rc == BK_OK && k < values; ++k) {
+            double x = buf[k];
+            int valid = is_mode    ? x == -1.0 || x == 0.0 || x == 1.0
+                        : is_event ? x == 0.0 || x == 1.0
+                                   : isfinite(x) && (!is_time || start + k == 0 || x > prev);
+            prev = x;
+            if (valid)
+                continue;
+            unsigned long long row = (unsigned long long)start + k / (size_t)cols;
+            unsigned long long col = k % (size_t)cols;
+            char where[64];
+            if (rank == 2)
+                snprintf(where, sizeof where, "row %llu column %llu", row, col);
+            else
+                snprintf(where, sizeof where, "row %llu", row);
+            if (is_mode)
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /mode %s is %g, not a mode "
+                             "(stick 0, slip+ 1, slip- -1)", path, where, x);
+            else if (is_event)
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /event %s is %g, not 0 or 1",
+                             path, where, x);
+            else if (!isfinite(x))
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s %s is %g, not finite", path,
+                             name, where, x);
+            else
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /time is not strictly increasing "
+                             "at row %llu (%.17g after %.17g)", path, row, x, k ? buf[k - 1] : before);
+        }
+        before = buf[values - 1];
+    }
+    free(buf);
+    close_id(dset);
+    if (rc != BK_OK || !is_time)
+        return rc;
+    if (rows > 0 && prev != v->t_reached)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: t_reached (%.17g) is not the last time "
+                       "(%.17g)", path, v->t_reached, prev);
+    if (v->complete && (rows == 0 || fabs(prev - v->t_end) > 1e-9 * fabs(v->t_end)))
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: marked complete but /time ends at %.17g, "
+                       "not t_end = %.17g", path, rows ? prev : NAN, v->t_end);
+    return BK_OK;
+}
+
+static int valid_mode(int8_t mode)
+{
+    return mode == -1 || mode == 0 || mode == 1;
+}
+
+/* /transitions in time order, each of an existing block, between modes, at a time the run
+ * reached, with finite values.  The bound is t_reached for a complete run; an unfinished
+ * run may have flushed transitions after its last row (with event_rows off there is no row
+ * at a transition), so there it is t_end. */
+static int scan_transitions(hid_t file, const verify_ctx *v, bk_error *err)
+{
+    const char *path = v->path;
+    hid_t dset, mem;
+    hsize_t count;
+    if (open_transitions(file, path, &dset, &mem, &count, err) != BK_OK)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: %s", path,
+                       err ? err->message : "/transitions cannot be read");
+    double bound = v->complete ? v->t_reached : v->t_end;
+    bound += 1e-9 * fabs(bound);
+    bk_transition *buf = malloc(TRANSITION_BUFFER * sizeof *buf);
+    int rc = buf ? BK_OK : BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    double prev = 0.0;
+    for (hsize_t start = 0; rc == BK_OK && start < count; start += TRANSITION_BUFFER) {
+        size_t n = count - start < TRANSITION_BUFFER ? (size_t)(count - start) : TRANSITION_BUFFER;
+        if (read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
+            rc = H5_DAMAGED(err, "%s: damaged: /transitions rows %llu..%llu cannot be read", path,
+                            (unsigned long long)start, (unsigned long long)(start + n - 1));
+            break;
+        }
+        for (size_t k = 0; rc == BK_OK && k < n; ++k) {
+            const bk_transition *t = &buf[k];
+            unsigned long long row = (unsigned long long)(start + k);
+            if (!isfinite(t->t) || !isfinite(t->x) || !isfinite(t->v) || !isfinite(t->force))
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu has a value "
+                             "that is not finite (t %g, x %g, v %g, force %g)", path, row, t->t,
+                             t->x, t->v, t->force);
+            else if (t->t < prev)
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions is not in time order "
+                             "at row %llu (t = %.17g s after %.17g s)", path, row, t->t, prev);
+            else if (t->t > bound)
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu is at "
+                             "t = %.17g s, after the %s (%.17g s)", path, row, t->t,
+                             v->complete ? "end of the run" : "run's t_end",
+                             v->complete ? v->t_reached : v->t_end);
+            else if (t->block < 0 || t->block >= v->n_blocks)
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu names block "
+                             "%d, outside 0..%lld", path, row, (int)t->block, v->n_blocks - 1);
+            else if (!valid_mode(t->from) || !valid_mode(t->to))
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu goes from "
+                             "mode %d to %d; modes are stick 0, slip+ 1, slip- -1", path, row,
+                             (int)t->from, (int)t->to);
+            prev = t->t;
+        }
+    }
+    free(buf);
+    CLOSE_IDS(0, mem, dset);
+    return rc;
+}
+
+/* The datasets a file must hold: those its writer recorded, or for a file written before
+ * that record, those its stored config selects (time, driver, event if it does not load).
+ * Malloc'ed, comma-separated; NULL when out of memory. */
+static char *expected_datasets(hid_t file)
+{
+    char *names = recorded_datasets(file);
+    if (names)
+        return names;
+    bk_config *config = NULL;
+    bk_error ignored;
+    char list[DATASET_LIST_LEN] = "time,driver,event";
+    if (load_stored_config(file, "", &config, &ignored) == BK_OK)
+        layout_names(config->output.fields, config->model->n_friction_state,
+                     config->output.transitions, list, sizeof list);
+    bk_config_free(config);
+    return strdup(list);
+}
+
 /* The integrity check on an open file (see bk_h5_verify). */
 static int verify_open(hid_t file, const char *path, bk_error *err)
 {
-    int complete = 0;
-    long long n_blocks = 0;
-    double t_end = NAN, t_reached = NAN;
-    if (read_numeric_attr(file, "complete", H5T_NATIVE_INT, &complete) < 0 ||
-        read_numeric_attr(file, "n_blocks", H5T_NATIVE_LLONG, &n_blocks) < 0 ||
-        read_numeric_attr(file, "t_end", H5T_NATIVE_DOUBLE, &t_end) < 0 ||
-        read_numeric_attr(file, "t_reached", H5T_NATIVE_DOUBLE, &t_reached) < 0)
+    verify_ctx v = {path, 0, NAN, NAN, 0};
+    if (read_numeric_attr(file, "complete", H5T_NATIVE_INT, &v.complete) < 0 ||
+        read_numeric_attr(file, "n_blocks", H5T_NATIVE_LLONG, &v.n_blocks) < 0 ||
+        read_numeric_attr(file, "t_end", H5T_NATIVE_DOUBLE, &v.t_end) < 0 ||
+        read_numeric_attr(file, "t_reached", H5T_NATIVE_DOUBLE, &v.t_reached) < 0)
         return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: a root attribute (complete, n_blocks, t_end, "
                        "t_reached) is missing", path);
-    static const char *const required[] = {"time", "driver", "event"};
-    for (size_t k = 0; k < 3; ++k)
-        if (H5Lexists(file, required[k], H5P_DEFAULT) <= 0)
-            return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: no /%s", path, required[k]);
+    if (v.n_blocks < 1 || !isfinite(v.t_end) || !(v.t_end > 0.0))
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: root attributes n_blocks = %lld, t_end = %g "
+                       "are not a run's", path, v.n_blocks, v.t_end);
+    int rc = require_datasets(file, path, "time,driver,event", err);
+    if (rc != BK_OK)
+        return rc;
+    char *expected = expected_datasets(file);
+    if (!expected)
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    rc = require_datasets(file, path, expected, err);
+    free(expected);
+    if (rc != BK_OK)
+        return rc;
     hid_t time;
     hsize_t rows, cols;
     int rank;
-    int rc = open_series(file, path, "time", &time, &rows, &cols, &rank, err);
+    rc = open_series(file, path, "time", &time, &rows, &cols, &rank, err);
     if (rc != BK_OK)
         return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: %s", path, err ? err->message : "/time");
-    double *t = malloc((rows ? rows : 1) * sizeof *t);
-    if (!t) {
-        close_id(time);
-        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
-    }
-    herr_t read = rows ? read_block(time, 1, 0, rows, 0, 1, H5T_NATIVE_DOUBLE, t) : 0;
     close_id(time);
-    rc = BK_OK;
-    if (read < 0)
-        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /time cannot be read", path);
-    for (hsize_t i = 0; rc == BK_OK && i < rows; ++i)
-        if (!isfinite(t[i]) || (i > 0 && !(t[i] > t[i - 1])))
-            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /time is not strictly increasing at row %llu "
-                         "(%.17g after %.17g)", path, (unsigned long long)i, t[i], i ? t[i - 1] : NAN);
-    if (rc == BK_OK && rows > 0 && t[rows - 1] != t_reached)
-        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: t_reached (%.17g) is not the last time (%.17g)",
-                     path, t_reached, t[rows - 1]);
-    if (rc == BK_OK && complete && (rows == 0 || fabs(t[rows - 1] - t_end) > 1e-9 * fabs(t_end)))
-        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: marked complete but /time ends at %.17g, not "
-                     "t_end = %.17g", path, rows ? t[rows - 1] : NAN, t_end);
-    free(t);
-    if (rc != BK_OK)
-        return rc;
+    if (rank != 1)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /time has rank %d, not 1", path, rank);
     name_list list;
     if (list_series(file, &list) != 0)
         return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: cannot list the datasets", path);
+    /* Shapes first: a short series is named as such rather than as a read error. */
     for (size_t k = 0; rc == BK_OK && k < list.count; ++k) {
         hid_t d;
         hsize_t r, c;
@@ -1764,14 +2547,34 @@ static int verify_open(hid_t file, const char *path, bk_error *err)
         if (r != rows)
             rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s has %llu rows, /time has %llu", path,
                          list.names[k], (unsigned long long)r, (unsigned long long)rows);
-        else if (per_block && (long long)c != n_blocks)
+        else if (per_block && (long long)c != v.n_blocks)
             rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s has %llu columns for %lld blocks", path,
-                         list.names[k], (unsigned long long)c, n_blocks);
+                         list.names[k], (unsigned long long)c, v.n_blocks);
     }
+    /* /time before the others, so that its own faults are named first. */
+    if (rc == BK_OK)
+        rc = scan_series(file, &v, "time", err);
+    for (size_t k = 0; rc == BK_OK && k < list.count; ++k)
+        if (strcmp(list.names[k], "time") != 0)
+            rc = scan_series(file, &v, list.names[k], err);
     name_list_free(&list);
+    if (rc == BK_OK && H5Lexists(file, "transitions", H5P_DEFAULT) > 0)
+        rc = scan_transitions(file, &v, err);
+    if (rc == BK_OK && H5Lexists(file, "checkpoint", H5P_DEFAULT) > 0) {
+        bk_checkpoint cp;
+        checkpoint_record rec;
+        int slot, legacy;
+        bk_error why = {0};
+        int found = find_checkpoint(file, path, (size_t)v.n_blocks, SIZE_MAX, &cp, &rec, &slot,
+                                    &legacy, &why);
+        if (found == BK_OK)
+            bk_checkpoint_free(&cp);
+        else if (!legacy) /* an older bksim's checkpoint cannot be verified, but is no damage */
+            rc = BK_FAIL(err, found, "%s", why.message);
+    }
     if (rc != BK_OK)
         return rc;
-    return complete ? BK_OK : BK_INCOMPLETE;
+    return v.complete ? BK_OK : BK_INCOMPLETE;
 }
 
 int bk_h5_verify(const char *path, bk_error *err)
@@ -1802,9 +2605,17 @@ int bk_h5_info(const char *path, FILE *out, bk_error *err)
         if (!stick || !slip)
             rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
     }
-    if (rc == BK_OK)
-        rc = count_phases(file, path, (size_t)n_blocks, stick, slip, &total,
-                          &have_transitions, err);
+    /* Phases that cannot be counted (a damaged /transitions) still leave a summary; the
+     * integrity check below names the damage. */
+    bk_error phase_err = {0};
+    int phases = rc == BK_OK ? count_phases(file, path, (size_t)n_blocks, stick, slip, &total,
+                                            &have_transitions, &phase_err)
+                             : rc;
+    if (phases == BK_ERR_NOMEM) {
+        rc = phases;
+        if (err)
+            *err = phase_err;
+    }
     if (rc != BK_OK) {
         free(stick);
         free(slip);
@@ -1847,10 +2658,16 @@ int bk_h5_info(const char *path, FILE *out, bk_error *err)
         fprintf(out, "rows         ? (no /time)\n");
     fprintf(out, "config:\n");
     print_indented(out, config ? config : "(not stored)");
-    fprintf(out, "phases per block:\n");
-    for (long long i = 0; i < n_blocks; ++i)
-        fprintf(out, "    block %lld: %ld stick, %ld slip\n", i, stick[i], slip[i]);
-    if (have_transitions)
+    if (phases != BK_OK) {
+        fprintf(out, "phases per block: not counted (%s)\n", phase_err.message);
+    } else {
+        fprintf(out, "phases per block:\n");
+        for (long long i = 0; i < n_blocks; ++i)
+            fprintf(out, "    block %lld: %ld stick, %ld slip\n", i, stick[i], slip[i]);
+    }
+    if (phases != BK_OK && have_transitions)
+        fprintf(out, "transitions  %ld (not all readable)\n", total);
+    else if (have_transitions)
         fprintf(out, "transitions  %ld\n", total);
     else
         fprintf(out, "transitions  not recorded\n");
