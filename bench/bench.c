@@ -229,6 +229,8 @@ static int cut_chain(const char *config, size_t n, const char *extra, char *path
             fclose(f);
         if (in)
             fclose(in);
+        if (fd >= 0)
+            remove(path);
         return -1;
     }
     char line[256];

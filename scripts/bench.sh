@@ -135,4 +135,12 @@ GP
 rm -f "$out"/scaling_*.dat
 
 scripts/bench_tables.sh "$out" > "$out/tables.md"
+# A full run into bench/ also refreshes the tables README quotes (between bench markers).
+if [ "$out" = bench ] && grep -q '<!-- bench:begin -->' README.md && grep -q '<!-- bench:end -->' README.md; then
+    awk -v tables="$out/tables.md" '
+        /<!-- bench:begin -->/ { print; while ((getline line < tables) > 0) print line; skip = 1; next }
+        /<!-- bench:end -->/   { skip = 0 }
+        !skip' README.md > README.md.new
+    mv README.md.new README.md
+fi
 echo "benchmark written to $out/"

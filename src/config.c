@@ -816,8 +816,10 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
     if (law->validate) {
         char msg[256];
         int bad = law->validate(b->friction_params, msg, sizeof msg);
-        if (bad >= 0) {
-            entry *at = origin[bad];
+        entry *at = bad >= 0 ? origin[bad] : NULL;
+        /* The same conflict in every block of a long chain is reported once: only an
+         * earlier-ranked one is worth the message. */
+        if (bad >= 0 && !(at && at->rank >= ld->error_rank)) {
             /* A conflict with this block's own value is reported at the shared key: name the
              * block and where its value came from. */
             char block_note[640] = "";
@@ -1051,20 +1053,13 @@ static void check_method_fits(loader *ld, const bk_config *c)
     if (!method || strcmp(method->value, "exact") != 0 || !c->model || c->prescribed ||
         ld->error_rank != LONG_MAX)
         return;
-    const bk_model *m = c->model;
-    if (bk_model_is_affine(m))
-        return;
-    for (size_t i = 0; i < m->n_blocks; ++i) {
-        const bk_friction_law *law = m->blocks[i].law;
-        if (law->n_state > 0 || !(law->flags & BK_FRICTION_CONSTANT_SLIDING)) {
-            report_entry(ld, method,
-                         "needs Coulomb friction (a constant sliding force, no friction state) on "
-                         "every block; block %zu uses law %s (allowed: auto, or an integrator such "
-                         "as gsl_rk8pd or cvode_bdf)",
-                         i, law->name);
-            return;
-        }
-    }
+    size_t i = bk_model_first_non_affine_block(c->model);
+    if (i < c->model->n_blocks)
+        report_entry(ld, method,
+                     "needs Coulomb friction (a constant sliding force, no friction state) on every "
+                     "block; block %zu uses law %s (allowed: auto, or an integrator such as gsl_rk8pd "
+                     "or cvode_bdf)",
+                     i, c->model->blocks[i].law->name);
 }
 
 static int has_section(loader *ld, const char *section)

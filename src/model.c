@@ -137,12 +137,17 @@ double bk_model_max_angular_frequency(const bk_model *model)
     return sqrt(max_rate);
 }
 
+size_t bk_model_first_non_affine_block(const bk_model *model)
+{
+    for (size_t i = 0; i < model->n_blocks; ++i) {
+        const bk_friction_law *law = model->blocks[i].law;
+        if (law->n_state > 0 || !(law->flags & BK_FRICTION_CONSTANT_SLIDING))
+            return i;
+    }
+    return model->n_blocks;
+}
+
 int bk_model_is_affine(const bk_model *model)
 {
-    if (model->n_friction_state > 0)
-        return 0;
-    for (size_t i = 0; i < model->n_blocks; ++i)
-        if (!(model->blocks[i].law->flags & BK_FRICTION_CONSTANT_SLIDING))
-            return 0;
-    return 1;
+    return bk_model_first_non_affine_block(model) == model->n_blocks;
 }

@@ -121,14 +121,14 @@ static int emit_row(run_ctx *ctx, double t, int is_event)
         .dissipation = scene->dissipation,
         .is_event = is_event,
     };
-    ctx->t_last_row = t;
-    ctx->steps_since_row = 0;
-    ctx->stats->rows++;
     /* Rows can come without steps (all stuck, or dense sampling): a stop request and the
-     * wall clock are checked here too. */
+     * wall clock are checked here too, before the row counts as written. */
     int rc = report_progress(ctx, t);
     if (rc != BK_OK)
         return rc;
+    ctx->t_last_row = t;
+    ctx->steps_since_row = 0;
+    ctx->stats->rows++;
     if (ctx->sink && ctx->sink->sample) {
         rc = ctx->sink->sample(ctx->sink->self, &sample, ctx->err);
         if (rc != BK_OK)

@@ -795,7 +795,7 @@ static void test_sigkill_restart_loop(void **state)
     free(text);
     assert_true(wall > 0.0);
     unsigned long long lcg = 20250101; /* fixed: the same kill times on every run of the test */
-    int kills = 0, restarts = 0, fresh_starts = 0;
+    int kills = 0, restarts = 0, fresh_starts = 0, finished_by_restart = 0;
     for (int chain = 0; chain < 4; ++chain) {
         char out[512];
         snprintf(out, sizeof out, "%s/killed_%d.h5", tmpdir, chain);
@@ -812,7 +812,9 @@ static void test_sigkill_restart_loop(void **state)
                 snprintf(cmd, sizeof cmd, "rm -f %s.part; ./bksim run %s -o %s & pid=$!; sleep %.3f; "
                          "kill -9 $pid 2>/dev/null; wait $pid", out, common, out, delay);
             restarts += have_part;
+            int was_restart = have_part;
             status = run(cmd, &text);
+            finished_by_restart += status == 0 && was_restart;
             if (status == 137) {
                 ++kills;
                 have_part = 1;
@@ -832,9 +834,11 @@ static void test_sigkill_restart_loop(void **state)
         bk_error err = {0};
         assert_int_equal(bk_h5_verify(out, &err), BK_OK);
     }
-    print_message("4 runs of %.2f s: %d kills, %d restarts, %d fresh starts\n", wall, kills, restarts,
-                  fresh_starts);
+    print_message("4 runs of %.2f s: %d kills, %d restarts, %d fresh starts, %d runs finished by a restart\n",
+                  wall, kills, restarts, fresh_starts, finished_by_restart);
     assert_true(kills >= 4);
+    /* The restarts must work, not only fresh starts that happen to outrun the kills. */
+    assert_true(finished_by_restart >= 2);
 }
 
 static void test_restart_errors(void **state)

@@ -337,10 +337,8 @@ static void test_file_errors(void **state)
     unlink(path);
 }
 
-/* A [friction.I] that changes law takes none of [friction]'s parameters; a per-block
- * override of the same law inherits them. */
-/* Many [block.I] sections (a generated config): every one lands on its block, the last
- * of a repeated key wins over [block], and a key given three times names its first line. */
+/* Many [block.I] sections (a generated config): every one overrides [block] for its block,
+ * the others keep [block]'s value, and a key given three times names its first line. */
 static void test_many_sections(void **state)
 {
     (void)state;
@@ -365,6 +363,8 @@ static void test_many_sections(void **state)
     assert_non_null(strstr(err.message, "t.ini:5: [block] mass: duplicate key (first set at line 4)"));
 }
 
+/* A [friction.I] that changes law takes none of [friction]'s parameters; a per-block
+ * override of the same law inherits them. */
 static void test_per_block_friction(void **state)
 {
     (void)state;

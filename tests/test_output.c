@@ -1574,6 +1574,17 @@ static void test_restart_from_torn_checkpoint(void **state)
     poke(part, "time", rows - 1, 0, H5T_NATIVE_DOUBLE, &wrong_t);
     expect_resume_refused(f->path, "/checkpoint/a: its last row is at t = ");
     expect_resume_refused(f->path, "/checkpoint/b: not written");
+
+    /* Stopped while writing its first checkpoint: no restart point, but no damage either. */
+    run_into(config, f->path, 1, 700);
+    poke(part, "checkpoint/a/x", 0, 0, H5T_NATIVE_DOUBLE, &x);
+    assert_int_equal(bk_h5_verify(part, &err), BK_INCOMPLETE);
+    assert_int_equal(bk_h5_restartable(f->path, &t, &err), 0);
+    bk_config *resumed = NULL;
+    bk_checkpoint cp;
+    bk_h5_writer *w = NULL;
+    assert_int_equal(bk_h5_writer_resume(&w, part, &resumed, &cp, &err), BK_ERR_INVALID);
+    assert_non_null(strstr(err.message, "the run stopped while writing its first one"));
     bk_config_free(config);
 }
 

@@ -74,8 +74,11 @@ double bk_model_max_angular_frequency(const bk_model *model);
 void bk_model_neighbours(const bk_model *model, size_t i, long *left, long *right);
 /* Number of neighbours block i is coupled to (walls included), 0..2. */
 int bk_model_coupling_count(const bk_model *model, size_t i);
-/* 1 when every block's law is stateless with a constant sliding force (Coulomb): between
- * mode changes the chain is then linear with constant coefficients (method = exact). */
+/* The first block whose law has a state or a velocity-dependent sliding force, or n_blocks
+ * when there is none: every law Coulomb-like, so between mode changes the chain is linear
+ * with constant coefficients (what method = exact needs). */
+size_t bk_model_first_non_affine_block(const bk_model *model);
+/* bk_model_first_non_affine_block(model) == n_blocks */
 int bk_model_is_affine(const bk_model *model);
 
 #endif

@@ -50,8 +50,10 @@ void bk_h5_writer_abandon(bk_h5_writer *writer, const char *reason, const bk_run
  * bk_checkpoint_free), truncates every dataset to the rows written up to the checkpoint, and
  * returns a writer that appends from there and renames to <path> when finished.  Refuses
  * with BK_ERR_DAMAGED when no checkpoint verifies (the message says what is wrong with each
- * slot), BK_ERR_INVALID when there is no checkpoint or no .part.  On failure nothing is
- * returned and the file is unchanged. */
+ * slot), BK_ERR_INVALID when there is no checkpoint (none yet, or only a first one cut
+ * short) or no .part.  On failure nothing is returned; the rows before the checkpoint are
+ * never changed, but a failure after the checkpoint verified may leave the file's recorded
+ * size extended, a torn last chunk rewritten, or datasets already cut to the checkpoint. */
 int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config,
                         bk_checkpoint *checkpoint, bk_error *err);
 

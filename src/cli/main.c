@@ -81,21 +81,27 @@ static const char *const keys_help =
 
 static volatile sig_atomic_t stop_requested = 0;
 
+/* A repeated SIGXCPU is the kernel's reminder once a second past the soft CPU limit, not
+ * a second request: only SIGINT, SIGTERM and SIGHUP escalate. */
 static void on_signal(int signo)
 {
-    (void)signo;
+    if (stop_requested && signo != SIGXCPU) {
+        signal(signo, SIG_DFL); /* both async-signal-safe */
+        raise(signo);
+        return;
+    }
     stop_requested = 1;
 }
 
 /* The first SIGINT, SIGTERM, SIGHUP (terminal gone) or SIGXCPU (a batch system's CPU limit)
- * asks the run to stop at the next step or row and leave a valid, incomplete file; the
- * handler then resets, so a second one stops the process at once. */
+ * asks the run to stop at the next step or row and leave a valid, incomplete file; a second
+ * SIGINT, SIGTERM or SIGHUP (any of them) then stops the process at once. */
 static void catch_stop_signals(void)
 {
     struct sigaction action;
     memset(&action, 0, sizeof action);
     action.sa_handler = on_signal;
-    action.sa_flags = (int)SA_RESETHAND;
+    action.sa_flags = SA_RESTART;
     sigemptyset(&action.sa_mask);
     const int signals[] = {SIGINT, SIGTERM, SIGHUP, SIGXCPU};
     for (size_t k = 0; k < sizeof signals / sizeof signals[0]; ++k)
@@ -294,7 +300,14 @@ static int cmd_run(int argc, char **argv)
     } else {
         /* A stopped run's progress is not thrown away by running the same command again. */
         double t_checkpoint = 0.0;
-        if (!args.force && path && bk_h5_restartable(path, &t_checkpoint, &err) == 1) {
+        int restartable = !args.force && path ? bk_h5_restartable(path, &t_checkpoint, &err) : 0;
+        if (restartable < 0) {
+            fprintf(stderr, "%s\n", err.message);
+            bk_config_free(config);
+            free(args.overrides);
+            return EXIT_RUN_FAILED;
+        }
+        if (restartable == 1) {
             fprintf(stderr,
                     "%s.part holds a run stopped at its checkpoint t = %.17g s: continue it with "
                     "`bksim run --restart %s.part`, or pass --force to start over\n",

@@ -1297,7 +1297,10 @@ static int slot_matches_data(hid_t file, const bk_checkpoint *cp, const checkpoi
 
 /* Read one slot of /checkpoint into cp (allocated here; freed again unless BK_OK) and check
  * it: its sizes (n_state SIZE_MAX: any), its checksum and its agreement with the datasets.
- * BK_OK; BK_ERR_NOMEM; or BK_ERR_DAMAGED with why filled (no path: the caller adds it). */
+ * BK_OK; BK_ERR_NOMEM; BK_ERR_INVALID for a slot never written; SLOT_TORN for one whose own
+ * contents do not hold together (a write cut short); or BK_ERR_DAMAGED (it disagrees with the
+ * data); why filled (no path: the caller adds it). */
+#define SLOT_TORN 1
 static int read_slot(hid_t file, hid_t top, const char *name, size_t n_blocks, size_t n_state,
                      bk_checkpoint *cp, checkpoint_record *rec, char *why, size_t why_len)
 {
@@ -1305,7 +1308,7 @@ static int read_slot(hid_t file, hid_t top, const char *name, size_t n_blocks, s
     memset(rec, 0, sizeof *rec);
     if (H5Lexists(top, name, H5P_DEFAULT) <= 0) {
         snprintf(why, why_len, "not written");
-        return BK_ERR_DAMAGED;
+        return BK_ERR_INVALID;
     }
     hid_t group = H5Gopen2(top, name, H5P_DEFAULT);
     long long nb = -1, ns = -1;
@@ -1313,7 +1316,7 @@ static int read_slot(hid_t file, hid_t top, const char *name, size_t n_blocks, s
         read_numeric_attr(group, "n_state", H5T_NATIVE_LLONG, &ns) < 0) {
         CLOSE_IDS(-1, group);
         snprintf(why, why_len, "cannot be read (written only in part)");
-        return BK_ERR_DAMAGED;
+        return SLOT_TORN;
     }
     /* The counts size the arrays, so they are checked before the checksum can be. */
     int fits = nb == (long long)n_blocks && ns >= 0 && ns <= (long long)(SIZE_MAX / 64) &&
@@ -1365,10 +1368,10 @@ static int read_slot(hid_t file, hid_t top, const char *name, size_t n_blocks, s
     int rc = BK_OK;
     if (ok < 0) {
         snprintf(why, why_len, "cannot be read (written only in part)");
-        rc = BK_ERR_DAMAGED;
+        rc = SLOT_TORN;
     } else if (checkpoint_hash(cp, rec) != stored) {
         snprintf(why, why_len, "checksum mismatch (written only in part, or altered)");
-        rc = BK_ERR_DAMAGED;
+        rc = SLOT_TORN;
     } else if (rec->rows < 0 || rec->transition_rows < 0 ||
                slot_matches_data(file, cp, rec, why, why_len) < 0) {
         if (rec->rows < 0 || rec->transition_rows < 0)
@@ -1422,6 +1425,14 @@ static int find_checkpoint(hid_t file, const char *path, size_t n_blocks, size_t
     if (best < 0) {
         if (status[0] == BK_ERR_NOMEM || status[1] == BK_ERR_NOMEM)
             return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory reading /checkpoint", path);
+        /* One slot never written, the other cut short: the run was stopped while writing
+         * its first checkpoint.  The data are fine; there is just no restart point yet. */
+        if ((status[0] == BK_ERR_INVALID || status[1] == BK_ERR_INVALID) &&
+            status[0] != BK_ERR_DAMAGED && status[1] != BK_ERR_DAMAGED)
+            return BK_FAIL(err, BK_ERR_INVALID,
+                           "%s: no complete checkpoint to restart from (the run stopped while "
+                           "writing its first one: /checkpoint/a: %s; /checkpoint/b: %s)",
+                           path, why[0], why[1]);
         return BK_FAIL(err, BK_ERR_DAMAGED,
                        "%s: damaged: no checkpoint verifies, so a restart would continue from "
                        "an inconsistent state (/checkpoint/a: %s; /checkpoint/b: %s)",
@@ -2430,14 +2441,22 @@ static int valid_mode(int8_t mode)
  * reached, with finite values.  The bound is t_reached for a complete run; an unfinished
  * run may have flushed transitions after its last row (with event_rows off there is no row
  * at a transition), so there it is t_end. */
+/* Restate the error just recorded as damage to path; its message is copied first, since
+ * BK_FAIL formats into the same buffer. */
+static int mark_damaged(bk_error *err, const char *path, const char *fallback)
+{
+    char reason[BK_ERROR_MESSAGE_LEN];
+    snprintf(reason, sizeof reason, "%s", err && err->message[0] ? err->message : fallback);
+    return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: %s", path, reason);
+}
+
 static int scan_transitions(hid_t file, const verify_ctx *v, bk_error *err)
 {
     const char *path = v->path;
     hid_t dset, mem;
     hsize_t count;
     if (open_transitions(file, path, &dset, &mem, &count, err) != BK_OK)
-        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: %s", path,
-                       err ? err->message : "/transitions cannot be read");
+        return mark_damaged(err, path, "/transitions cannot be read");
     double bound = v->complete ? v->t_reached : v->t_end;
     bound += 1e-9 * fabs(bound);
     bk_transition *buf = malloc(TRANSITION_BUFFER * sizeof *buf);
@@ -2526,7 +2545,7 @@ static int verify_open(hid_t file, const char *path, bk_error *err)
     int rank;
     rc = open_series(file, path, "time", &time, &rows, &cols, &rank, err);
     if (rc != BK_OK)
-        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: %s", path, err ? err->message : "/time");
+        return mark_damaged(err, path, "/time");
     close_id(time);
     if (rank != 1)
         return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /time has rank %d, not 1", path, rank);
@@ -2569,7 +2588,8 @@ static int verify_open(hid_t file, const char *path, bk_error *err)
                                     &legacy, &why);
         if (found == BK_OK)
             bk_checkpoint_free(&cp);
-        else if (!legacy) /* an older bksim's checkpoint cannot be verified, but is no damage */
+        else if (!legacy && found != BK_ERR_INVALID) /* no damage: an older bksim's checkpoint
+                                                        cannot be verified; a first one torn */
             rc = BK_FAIL(err, found, "%s", why.message);
     }
     if (rc != BK_OK)

@@ -45,13 +45,14 @@ typedef struct ark_variant {
     ark_kind kind;
     ARKODE_ERKTableID erk;
     ARKODE_DIRKTableID dirk;
+    int takes_table; /* [solver] arkode_table replaces the table (arkode_erk, arkode_dirk) */
 } ark_variant;
 
-static const ark_variant variant_bs23 = {KIND_EXPLICIT, ARKODE_BOGACKI_SHAMPINE_4_2_3, ARKODE_DIRK_NONE};
-static const ark_variant variant_dp45 = {KIND_EXPLICIT, ARKODE_DORMAND_PRINCE_7_4_5, ARKODE_DIRK_NONE};
-static const ark_variant variant_erk = {KIND_EXPLICIT, ARKODE_ZONNEVELD_5_3_4, ARKODE_DIRK_NONE};
-static const ark_variant variant_dirk = {KIND_IMPLICIT, ARKODE_ERK_NONE, ARKODE_SDIRK_5_3_4};
-static const ark_variant variant_imex = {KIND_IMEX, ARKODE_ARK436L2SA_ERK_6_3_4, ARKODE_ARK436L2SA_DIRK_6_3_4};
+static const ark_variant variant_bs23 = {KIND_EXPLICIT, ARKODE_BOGACKI_SHAMPINE_4_2_3, ARKODE_DIRK_NONE, 0};
+static const ark_variant variant_dp45 = {KIND_EXPLICIT, ARKODE_DORMAND_PRINCE_7_4_5, ARKODE_DIRK_NONE, 0};
+static const ark_variant variant_erk = {KIND_EXPLICIT, ARKODE_ZONNEVELD_5_3_4, ARKODE_DIRK_NONE, 1};
+static const ark_variant variant_dirk = {KIND_IMPLICIT, ARKODE_ERK_NONE, ARKODE_SDIRK_5_3_4, 1};
+static const ark_variant variant_imex = {KIND_IMEX, ARKODE_ARK436L2SA_ERK_6_3_4, ARKODE_ARK436L2SA_DIRK_6_3_4, 0};
 
 /* The tables [solver] arkode_table selects.  Knoth-Wolke 3_3 is left out: it has no
  * embedding, so no error estimate for adaptive steps. */
@@ -295,7 +296,7 @@ static int create(void **mem, const bk_solver_options *options, const ark_varian
     ark->variant = *variant;
     ark->options = *options;
     /* A chosen table replaces the method's own (only arkode_erk and arkode_dirk take one). */
-    int chosen = options->arkode_table[0] && strcmp(options->arkode_table, "default") != 0
+    int chosen = variant->takes_table && options->arkode_table[0] && strcmp(options->arkode_table, "default") != 0
                      ? table_id(variant->kind, options->arkode_table)
                      : -1;
     if (chosen >= 0 && variant->kind == KIND_EXPLICIT)
