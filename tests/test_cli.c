@@ -14,6 +14,7 @@
 #include "bk_test.h"
 #include "bksim/bksim.h"
 #include "exact_single.h"
+#include "same_output.h"
 
 static char tmpdir[256];
 
@@ -707,36 +708,6 @@ static void test_limits(void **state)
     }
 }
 
-/* Every dataset of two output files, value for value. */
-static void assert_same_output(const char *a, const char *b)
-{
-    static const char *const names[] = {"time", "driver", "event", "x", "v", "friction", "cof", "mode",
-                                        "energy_kinetic", "energy_elastic", "work_driver", "dissipation"};
-    bk_error err = {0};
-    for (size_t k = 0; k < sizeof names / sizeof names[0]; ++k) {
-        double *da = NULL, *db = NULL;
-        size_t ra, ca, rb, cb;
-        assert_int_equal(bk_h5_read_doubles(a, names[k], &da, &ra, &ca, &err), BK_OK);
-        assert_int_equal(bk_h5_read_doubles(b, names[k], &db, &rb, &cb, &err), BK_OK);
-        assert_int_equal(ra, rb);
-        assert_int_equal(ca, cb);
-        assert_memory_equal(da, db, ra * ca * sizeof *da);
-        free(da);
-        free(db);
-    }
-    bk_transition *ta = NULL, *tb = NULL;
-    size_t na, nb;
-    assert_int_equal(bk_h5_read_transitions(a, &ta, &na, &err), BK_OK);
-    assert_int_equal(bk_h5_read_transitions(b, &tb, &nb, &err), BK_OK);
-    assert_int_equal(na, nb);
-    for (size_t k = 0; k < na; ++k) {
-        assert_true(ta[k].t == tb[k].t && ta[k].x == tb[k].x && ta[k].force == tb[k].force);
-        assert_int_equal(ta[k].block, tb[k].block);
-        assert_int_equal(ta[k].to, tb[k].to);
-    }
-    free(ta);
-    free(tb);
-}
 
 /* A run stopped again and again and restarted from its checkpoints each time ends with the
  * very output of an uninterrupted run: every row and transition bit-identical. */

@@ -245,11 +245,12 @@ static void put_dense(void *matrix, size_t row, size_t col, double value)
 /* The whole right-hand side, or the implicit (friction) part of its IMEX split. */
 static void evaluate(bk_scene *s, int implicit_part, double t, const double *y, double *out)
 {
-    double rest[16];
-    if (implicit_part)
+    if (implicit_part) {
+        double rest[16];
         assert_int_equal(bk_scene_rhs_split(t, y, rest, out, s), 0);
-    else
+    } else {
         assert_int_equal(bk_scene_rhs(t, y, out, s), 0);
+    }
 }
 
 /* The analytic Jacobian matches central differences of the right-hand side, for a chain
