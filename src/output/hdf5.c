@@ -994,56 +994,6 @@ static uint64_t hash_bytes(uint64_t h, const void *data, size_t n)
     return h;
 }
 
-/* Everything a restart reads from a slot, and where the datasets stood. */
-static uint64_t checkpoint_hash(const bk_checkpoint *cp, const checkpoint_record *rec)
-{
-    size_t n = cp->n_blocks, n_state = cp->n_state;
-    uint64_t h = FNV_OFFSET;
-    h = hash_u64(h, (uint64_t)rec->sequence);
-    h = hash_u64(h, (uint64_t)rec->rows);
-    h = hash_u64(h, (uint64_t)rec->transition_rows);
-    h = hash_f64(h, rec->last_transition_t);
-    h = hash_u64(h, (uint64_t)n);
-    h = hash_u64(h, (uint64_t)n_state);
-    h = hash_bytes(h, cp->mode, n);
-    h = hash_bytes(h, cp->from_rest, n);
-    h = hash_bytes(h, cp->extremum_armed, n);
-    for (size_t i = 0; i < n; ++i)
-        h = hash_f64(h, cp->x[i]);
-    for (size_t i = 0; i < n; ++i)
-        h = hash_f64(h, cp->v[i]);
-    for (size_t i = 0; i < n; ++i)
-        h = hash_f64(h, cp->t_switch[i]);
-    for (size_t i = 0; i < n; ++i)
-        h = hash_f64(h, cp->last_transition[i]);
-    for (size_t i = 0; i < n; ++i)
-        h = hash_u64(h, (uint64_t)cp->instant_count[i]);
-    for (size_t k = 0; k < n_state; ++k)
-        h = hash_f64(h, cp->state[k]);
-    h = hash_f64(h, cp->t);
-    h = hash_f64(h, cp->work_driver);
-    h = hash_f64(h, cp->dissipation);
-    h = hash_f64(h, cp->elastic_initial);
-    h = hash_f64(h, cp->kinetic_initial);
-    h = hash_f64(h, cp->t_last_row);
-    h = hash_u64(h, (uint64_t)cp->next_sample);
-    h = hash_u64(h, (uint64_t)cp->steps_since_row);
-    for (size_t i = 0; i < N_STATS; ++i) {
-        const char *field = (const char *)&cp->stats + STATS[i].offset;
-        if (STATS[i].is_long) {
-            long value;
-            memcpy(&value, field, sizeof value);
-            h = hash_u64(h, (uint64_t)value);
-        } else {
-            double value;
-            memcpy(&value, field, sizeof value);
-            h = hash_f64(h, value);
-        }
-    }
-    /* The method as read back: at most sizeof - 1 characters. */
-    return hash_bytes(h, cp->stats.method, strnlen(cp->stats.method, sizeof cp->stats.method - 1));
-}
-
 static herr_t write_stats(hid_t file, const bk_run_stats *stats);
 static herr_t read_block_xfer(hid_t dset, int rank, hsize_t start, hsize_t count, hsize_t col,
                               hsize_t ncols, hid_t mem_type, void *buf, hid_t dxpl);
@@ -1106,6 +1056,42 @@ static hid_t open_or_create_group(hid_t parent, const char *name, int *created)
     X("t", t) X("work_driver", work_driver) X("dissipation", dissipation)                  \
     X("elastic_initial", elastic_initial) X("kinetic_initial", kinetic_initial)            \
     X("t_last_row", t_last_row)
+
+/* Everything a restart reads from a slot, and where the datasets stood. */
+static uint64_t checkpoint_hash(const bk_checkpoint *cp, const checkpoint_record *rec)
+{
+    size_t n = cp->n_blocks;
+    uint64_t h = FNV_OFFSET;
+    h = hash_u64(h, (uint64_t)rec->sequence);
+    h = hash_u64(h, (uint64_t)rec->rows);
+    h = hash_u64(h, (uint64_t)rec->transition_rows);
+    h = hash_f64(h, rec->last_transition_t);
+    h = hash_u64(h, (uint64_t)n);
+    h = hash_u64(h, (uint64_t)cp->n_state);
+    /* The same field lists as the writer and the reader, so no field escapes the checksum. */
+#define HASH(name, file_type, mem_type, count, field) h = hash_bytes(h, cp->field, (count) * sizeof *cp->field);
+    CHECKPOINT_ARRAYS(HASH)
+#undef HASH
+#define HASH(name, field) h = hash_f64(h, cp->field);
+    CHECKPOINT_SCALARS(HASH)
+#undef HASH
+    h = hash_u64(h, (uint64_t)cp->next_sample);
+    h = hash_u64(h, (uint64_t)cp->steps_since_row);
+    for (size_t i = 0; i < N_STATS; ++i) {
+        const char *field = (const char *)&cp->stats + STATS[i].offset;
+        if (STATS[i].is_long) {
+            long value;
+            memcpy(&value, field, sizeof value);
+            h = hash_u64(h, (uint64_t)value);
+        } else {
+            double value;
+            memcpy(&value, field, sizeof value);
+            h = hash_f64(h, value);
+        }
+    }
+    /* The method as read back: at most sizeof - 1 characters. */
+    return hash_bytes(h, cp->stats.method, strnlen(cp->stats.method, sizeof cp->stats.method - 1));
+}
 
 #define CHECKPOINT_UNITS                                                                   \
     "t: s, x: m, v: m/s, t_switch: s, last_transition: s, energies: J, t_last_row: s, "    \
