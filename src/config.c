@@ -23,6 +23,7 @@
 #include <ini.h>
 
 #include "bksim/solver.h"
+#include "output/layout.h"
 
 #define MAX_LINE_CHARS 190
 #define MAX_FILE_BYTES (1 << 20)
@@ -37,7 +38,6 @@
 static const char *const boundary_names[] = {"free", "fixed", "periodic", NULL};
 static const char *const spring_names[] = {"linear", "tension_only", NULL};
 static const char *const linear_solver_names[] = {"auto", "dense", "band", NULL};
-static const char *const field_names[] = {"x", "v", "friction", "cof", "mode", "energy", "state", NULL};
 
 /* "auto" (resolved by the run loop from the scene), then every registered back-end. */
 static const char *method_name(size_t i)
@@ -140,7 +140,7 @@ static const key_def keys[] = {
                 "time between samples, <= t_end; 0: rows only at transitions (and t = 0, t_end)"},
      BK_KEY_NUMBER, NULL, NULL, "t_end / 1000"},
     {"output", {"fields", "", 0, 0, 0, 0, "per-row datasets: all, or a list of x v friction cof mode energy state"},
-     BK_KEY_FIELDS, field_names, NULL, "all"},
+     BK_KEY_FIELDS, bk_output_field_names, NULL, "all"},
     {"output", {"transitions", "", 1, 0, 1, 0, "write the /transitions table"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
     {"output", {"event_rows", "", 1, 0, 1, 0, "add a row at every transition instant"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
     NUM("output", "max_bytes", "B", 1e10, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
@@ -476,10 +476,11 @@ static int parse_fields(const char *text, double *out, char *bad, size_t bad_len
             continue;
         }
         size_t i = 0;
-        for (; field_names[i]; ++i)
-            if (strlen(field_names[i]) == len && strncmp(field_names[i], start, len) == 0)
+        for (; bk_output_field_names[i]; ++i)
+            if (strlen(bk_output_field_names[i]) == len &&
+                strncmp(bk_output_field_names[i], start, len) == 0)
                 break;
-        if (!field_names[i]) {
+        if (!bk_output_field_names[i]) {
             snprintf(bad, bad_len, "%.*s", (int)len, start);
             return -1;
         }
@@ -1131,16 +1132,7 @@ static bk_config *build(loader *ld)
     }
     o->max_bytes = value_of(ld, "output", "max_bytes");
     if (c->model && ld->error_rank == LONG_MAX) {
-        /* Per row: time, driver, event; per block the chosen doubles and the int8 mode;
-         * energies and friction states as chosen. */
-        double per_block = 0.0;
-        const unsigned doubles[] = {BK_FIELD_X, BK_FIELD_V, BK_FIELD_FRICTION, BK_FIELD_COF};
-        for (size_t k = 0; k < sizeof doubles / sizeof doubles[0]; ++k)
-            per_block += (o->fields & doubles[k]) ? 8.0 : 0.0;
-        per_block += (o->fields & BK_FIELD_MODE) ? 1.0 : 0.0;
-        double per_row = 17.0 + per_block * (double)c->model->n_blocks +
-                         ((o->fields & BK_FIELD_ENERGY) ? 32.0 : 0.0) +
-                         ((o->fields & BK_FIELD_STATE) ? 8.0 * (double)c->model->n_friction_state : 0.0);
+        double per_row = bk_output_row_bytes(o->fields, c->model->n_blocks, c->model->n_friction_state);
         double bytes = (samples + 1.0) * per_row;
         if (bytes > o->max_bytes) {
             entry *at = interval ? interval : lookup(ld, "output", "max_bytes");

@@ -24,6 +24,7 @@
 #include <hdf5.h>
 
 #include "bksim/bksim.h"
+#include "output/layout.h"
 
 /* Rows buffered in memory before an append; also the row count of a 2-D chunk.  A chunk
  * of a T x N dataset is capped at CHUNK_BYTES so wide chains keep chunks (and the buffers,
@@ -323,112 +324,30 @@ done:
 
 /* --------------------------------------------------------------------- layout --- */
 
-enum series_shape { SHAPE_T, SHAPE_TN, SHAPE_TS };
-enum series_kind { KIND_F64, KIND_U8, KIND_I8 };
-
-typedef struct series_def {
-    const char *name;
-    unsigned field; /* BK_FIELD_* that selects it; 0 = always written */
-    enum series_shape shape;
-    enum series_kind kind;
-    const char *units;
-    const char *description;
-} series_def;
-
-enum {
-    S_TIME, S_DRIVER, S_EVENT, S_X, S_V, S_FRICTION, S_COF, S_MODE,
-    S_EKIN, S_EEL, S_WORK, S_DISS, S_STATE, N_SERIES
-};
-
-static const series_def SERIES[N_SERIES] = {
-    [S_TIME] = {"time", 0, SHAPE_T, KIND_F64, "s", "sample time"},
-    [S_DRIVER] = {"driver", 0, SHAPE_T, KIND_F64, "m", "driver displacement D(t)"},
-    [S_EVENT] = {"event", 0, SHAPE_T, KIND_U8, "1",
-                 "1 = row at a transition instant (post-transition state), 0 = regular sample"},
-    [S_X] = {"x", BK_FIELD_X, SHAPE_TN, KIND_F64, "m",
-             "block displacement from the relaxed reference configuration"},
-    [S_V] = {"v", BK_FIELD_V, SHAPE_TN, KIND_F64, "m/s", "block velocity"},
-    [S_FRICTION] = {"friction", BK_FIELD_FRICTION, SHAPE_TN, KIND_F64, "N",
-                    "interface shear force, positive when it resists +x motion "
-                    "(the force on the block is -friction)"},
-    [S_COF] = {"cof", BK_FIELD_COF, SHAPE_TN, KIND_F64, "1",
-               "apparent coefficient of friction: friction / normal force"},
-    [S_MODE] = {"mode", BK_FIELD_MODE, SHAPE_TN, KIND_I8, "1",
-                "block mode: stick 0, slip+ 1, slip- -1"},
-    [S_EKIN] = {"energy_kinetic", BK_FIELD_ENERGY, SHAPE_T, KIND_F64, "J",
-                "kinetic energy of all blocks"},
-    [S_EEL] = {"energy_elastic", BK_FIELD_ENERGY, SHAPE_T, KIND_F64, "J",
-               "elastic energy stored in all springs"},
-    [S_WORK] = {"work_driver", BK_FIELD_ENERGY, SHAPE_T, KIND_F64, "J",
-                "work done by the driver since t = 0"},
-    [S_DISS] = {"dissipation", BK_FIELD_ENERGY, SHAPE_T, KIND_F64, "J",
-                "frictional dissipation since t = 0"},
-    [S_STATE] = {"friction_state", BK_FIELD_STATE, SHAPE_TS, KIND_F64, "law-specific",
-                 "friction-law state variables; attribute 'block' gives each column's block"},
-};
-
-#define TRANSITIONS_UNITS "t: s, block: 1, from: 1, to: 1, x: m, v: m/s, force: N"
-#define TRANSITIONS_DESCRIPTION                                                           \
-    "mode transitions: time, block (0-based), from/to mode (stick 0, slip+ 1, slip- -1), " \
-    "position, velocity after the transition, applied spring force"
-
-/* Whether a run with these output fields and friction states writes this series: the one
- * rule behind both the layout and the list of datasets a reader must find. */
-static int series_selected(const series_def *def, unsigned fields, size_t n_state)
-{
-    if (def->field && !(fields & def->field))
-        return 0;
-    return def->shape != SHAPE_TS || n_state > 0;
-}
-
-/* The datasets a run of this config writes, comma-separated (recorded in the root attribute
- * "datasets" so that a check needs no config to know what must be there).  Fits in
- * DATASET_LIST_LEN. */
-#define DATASET_LIST_LEN 256
-static void layout_names(unsigned fields, size_t n_state, int transitions, char *buf,
-                         size_t len)
-{
-    size_t used = 0;
-    buf[0] = '\0';
-    for (int i = 0; i < N_SERIES; ++i)
-        if (series_selected(&SERIES[i], fields, n_state)) {
-            int n = snprintf(buf + used, len - used, "%s%s", used ? "," : "", SERIES[i].name);
-            if (n > 0 && (size_t)n < len - used)
-                used += (size_t)n;
-        }
-    if (transitions)
-        snprintf(buf + used, len - used, "%stransitions", used ? "," : "");
-}
-
-static hid_t kind_file_type(enum series_kind kind)
+static hid_t kind_file_type(bk_series_kind kind)
 {
     switch (kind) {
-    case KIND_U8:
+    case BK_KIND_U8:
         return H5T_STD_U8LE;
-    case KIND_I8:
+    case BK_KIND_I8:
         return H5T_STD_I8LE;
-    case KIND_F64:
+    case BK_KIND_F64:
         break;
     }
     return H5T_IEEE_F64LE;
 }
 
-static hid_t kind_mem_type(enum series_kind kind)
+static hid_t kind_mem_type(bk_series_kind kind)
 {
     switch (kind) {
-    case KIND_U8:
+    case BK_KIND_U8:
         return H5T_NATIVE_UINT8;
-    case KIND_I8:
+    case BK_KIND_I8:
         return H5T_NATIVE_INT8;
-    case KIND_F64:
+    case BK_KIND_F64:
         break;
     }
     return H5T_NATIVE_DOUBLE;
-}
-
-static size_t kind_size(enum series_kind kind)
-{
-    return kind == KIND_F64 ? sizeof(double) : 1;
 }
 
 typedef struct stat_def {
@@ -504,7 +423,7 @@ struct bk_h5_writer {
     char *part;
     hid_t file;
     size_t n_blocks;
-    series s[N_SERIES];
+    series s[BK_N_SERIES];
     size_t buffer_rows;
     size_t buffered;
     hsize_t rows_written;
@@ -671,8 +590,8 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
     if (stored >= 0)
         stored = write_string_attr(w->file, "overrides", overrides);
     free(overrides);
-    char names[DATASET_LIST_LEN];
-    layout_names(fields, n_state, config->output.transitions, names, sizeof names);
+    char names[BK_DATASET_LIST_LEN];
+    bk_output_dataset_names(fields, n_state, config->output.transitions, names, sizeof names);
     if (stored >= 0)
         stored = write_string_attr(w->file, "datasets", names);
     if (stored < 0)
@@ -682,14 +601,14 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
     size_t rows = CHUNK_BYTES / (widest * sizeof(double));
     w->buffer_rows = rows < 1 ? 1 : rows > MAX_BUFFER_ROWS ? MAX_BUFFER_ROWS : rows;
 
-    for (int i = 0; i < N_SERIES; ++i) {
-        const series_def *def = &SERIES[i];
+    for (int i = 0; i < BK_N_SERIES; ++i) {
+        const bk_series_def *def = &bk_series[i];
         series *s = &w->s[i];
-        if (!series_selected(def, fields, n_state))
+        if (!bk_series_selected(def, fields, n_state))
             continue;
-        s->rank = def->shape == SHAPE_T ? 1 : 2;
-        s->cols = def->shape == SHAPE_T ? 1 : def->shape == SHAPE_TN ? model->n_blocks : n_state;
-        s->elem = kind_size(def->kind);
+        s->rank = def->shape == BK_SHAPE_T ? 1 : 2;
+        s->cols = def->shape == BK_SHAPE_T ? 1 : def->shape == BK_SHAPE_TN ? model->n_blocks : n_state;
+        s->elem = bk_series_value_size(def->kind);
         s->buf = malloc(w->buffer_rows * s->cols * s->elem);
         if (!s->buf)
             return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for the /%s buffer", w->part,
@@ -701,7 +620,7 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
             return H5_FAIL(err, "%s: cannot create dataset /%s", w->part, def->name);
         if (describe(s->dset, def->units, def->description) < 0)
             return H5_FAIL(err, "%s: cannot write attributes of /%s", w->part, def->name);
-        if (i == S_STATE && write_state_blocks(s->dset, model) < 0)
+        if (i == BK_SERIES_STATE && write_state_blocks(s->dset, model) < 0)
             return H5_FAIL(err, "%s: cannot write attribute /friction_state/block", w->part);
     }
 
@@ -718,7 +637,7 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
         CLOSE_IDS(w->trans_dset, disk);
         if (w->trans_dset < 0)
             return H5_FAIL(err, "%s: cannot create dataset /transitions", w->part);
-        if (describe(w->trans_dset, TRANSITIONS_UNITS, TRANSITIONS_DESCRIPTION) < 0)
+        if (describe(w->trans_dset, BK_TRANSITIONS_UNITS, BK_TRANSITIONS_DESCRIPTION) < 0)
             return H5_FAIL(err, "%s: cannot write attributes of /transitions", w->part);
     }
     /* The variable-length strings above go to disk now, once: nothing rewrites them later
@@ -740,7 +659,7 @@ static herr_t close_writer(bk_h5_writer *w)
     herr_t rc = 0;
     if (w->file >= 0 && H5Fclose(w->file) < 0)
         rc = -1;
-    for (int i = 0; i < N_SERIES; ++i) {
+    for (int i = 0; i < BK_N_SERIES; ++i) {
         if (w->s[i].dset >= 0 && H5Dclose(w->s[i].dset) < 0)
             rc = -1;
         w->s[i].dset = H5I_INVALID_HID;
@@ -755,7 +674,7 @@ static herr_t close_writer(bk_h5_writer *w)
 
 static void free_writer(bk_h5_writer *w)
 {
-    for (int i = 0; i < N_SERIES; ++i)
+    for (int i = 0; i < BK_N_SERIES; ++i)
         free(w->s[i].buf);
     free(w->trans_buf);
     free(w->path);
@@ -781,7 +700,7 @@ int bk_h5_writer_open(bk_h5_writer **out, const bk_config *config, const char *p
     if (!w)
         return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
     w->file = w->trans_dset = w->trans_mem = H5I_INVALID_HID;
-    for (int i = 0; i < N_SERIES; ++i)
+    for (int i = 0; i < BK_N_SERIES; ++i)
         w->s[i].dset = H5I_INVALID_HID;
     w->n_blocks = config->model->n_blocks;
     w->path = strdup(path);
@@ -856,14 +775,14 @@ static int flush_all(bk_h5_writer *w, bk_error *err)
 {
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
     if (w->buffered > 0) {
-        for (int i = 0; i < N_SERIES; ++i) {
+        for (int i = 0; i < BK_N_SERIES; ++i) {
             series *s = &w->s[i];
             if (s->dset < 0)
                 continue;
             if (append(s->dset, s->rank, w->rows_written, (hsize_t)w->buffered,
-                       (hsize_t)s->cols, kind_mem_type(SERIES[i].kind), s->buf) < 0) {
+                       (hsize_t)s->cols, kind_mem_type(bk_series[i].kind), s->buf) < 0) {
                 w->failed = 1;
-                return H5_FAIL(err, "%s: cannot append rows to /%s", w->part, SERIES[i].name);
+                return H5_FAIL(err, "%s: cannot append rows to /%s", w->part, bk_series[i].name);
             }
         }
         w->rows_written += w->buffered;
@@ -896,30 +815,30 @@ static int sink_sample(void *self, const bk_sample *sample, bk_error *err)
     if (sample->n_blocks != w->n_blocks)
         return BK_FAIL(err, BK_ERR_INVALID, "%s: sample has %zu blocks, the file %zu",
                        w->part, sample->n_blocks, w->n_blocks);
-    const void *arrays[N_SERIES] = {
-        [S_X] = sample->x,
-        [S_V] = sample->v,
-        [S_FRICTION] = sample->friction,
-        [S_COF] = sample->cof,
-        [S_MODE] = sample->mode,
-        [S_STATE] = sample->friction_state,
+    const void *arrays[BK_N_SERIES] = {
+        [BK_SERIES_X] = sample->x,
+        [BK_SERIES_V] = sample->v,
+        [BK_SERIES_FRICTION] = sample->friction,
+        [BK_SERIES_COF] = sample->cof,
+        [BK_SERIES_MODE] = sample->mode,
+        [BK_SERIES_STATE] = sample->friction_state,
     };
     /* Check before copying anything so a rejected sample leaves no partial row. */
-    for (int i = 0; i < N_SERIES; ++i)
-        if (SERIES[i].shape != SHAPE_T && w->s[i].dset >= 0 && !arrays[i])
+    for (int i = 0; i < BK_N_SERIES; ++i)
+        if (bk_series[i].shape != BK_SHAPE_T && w->s[i].dset >= 0 && !arrays[i])
             return BK_FAIL(err, BK_ERR_INVALID, "%s: sample lacks the values of /%s",
-                           w->part, SERIES[i].name);
+                           w->part, bk_series[i].name);
     size_t row = w->buffered;
     uint8_t event = sample->is_event ? 1 : 0;
-    put(&w->s[S_TIME], row, &sample->t);
-    put(&w->s[S_DRIVER], row, &sample->driver);
-    put(&w->s[S_EVENT], row, &event);
-    put(&w->s[S_EKIN], row, &sample->kinetic_energy);
-    put(&w->s[S_EEL], row, &sample->elastic_energy);
-    put(&w->s[S_WORK], row, &sample->work_driver);
-    put(&w->s[S_DISS], row, &sample->dissipation);
-    for (int i = 0; i < N_SERIES; ++i)
-        if (SERIES[i].shape != SHAPE_T)
+    put(&w->s[BK_SERIES_TIME], row, &sample->t);
+    put(&w->s[BK_SERIES_DRIVER], row, &sample->driver);
+    put(&w->s[BK_SERIES_EVENT], row, &event);
+    put(&w->s[BK_SERIES_EKIN], row, &sample->kinetic_energy);
+    put(&w->s[BK_SERIES_EEL], row, &sample->elastic_energy);
+    put(&w->s[BK_SERIES_WORK], row, &sample->work_driver);
+    put(&w->s[BK_SERIES_DISS], row, &sample->dissipation);
+    for (int i = 0; i < BK_N_SERIES; ++i)
+        if (bk_series[i].shape != BK_SHAPE_T)
             put(&w->s[i], row, arrays[i]);
     w->buffered = row + 1;
     w->t_buffered = sample->t;
@@ -1559,7 +1478,7 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
     if (!w)
         return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
     w->file = w->trans_dset = w->trans_mem = H5I_INVALID_HID;
-    for (int i = 0; i < N_SERIES; ++i)
+    for (int i = 0; i < BK_N_SERIES; ++i)
         w->s[i].dset = H5I_INVALID_HID;
     w->path = is_part ? strndup(path, len - 5) : strdup(path);
     w->part = malloc(len + sizeof ".part");
@@ -1626,19 +1545,19 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
         w->buffer_rows = buffer_rows < 1 ? 1 : buffer_rows > MAX_BUFFER_ROWS ? MAX_BUFFER_ROWS : buffer_rows;
         w->n_blocks = model->n_blocks;
         hsize_t rows = (hsize_t)rec.rows;
-        for (int i = 0; rc == BK_OK && i < N_SERIES; ++i) {
+        for (int i = 0; rc == BK_OK && i < BK_N_SERIES; ++i) {
             series *ser = &w->s[i];
-            if (H5Lexists(w->file, SERIES[i].name, H5P_DEFAULT) <= 0)
+            if (H5Lexists(w->file, bk_series[i].name, H5P_DEFAULT) <= 0)
                 continue;
-            ser->dset = H5Dopen2(w->file, SERIES[i].name, H5P_DEFAULT);
-            ser->rank = SERIES[i].shape == SHAPE_T ? 1 : 2;
-            ser->cols = SERIES[i].shape == SHAPE_T ? 1 : SERIES[i].shape == SHAPE_TN ? model->n_blocks : n_state;
-            ser->elem = kind_size(SERIES[i].kind);
+            ser->dset = H5Dopen2(w->file, bk_series[i].name, H5P_DEFAULT);
+            ser->rank = bk_series[i].shape == BK_SHAPE_T ? 1 : 2;
+            ser->cols = bk_series[i].shape == BK_SHAPE_T ? 1 : bk_series[i].shape == BK_SHAPE_TN ? model->n_blocks : n_state;
+            ser->elem = bk_series_value_size(bk_series[i].kind);
             ser->buf = malloc(w->buffer_rows * ser->cols * ser->elem);
             if (ser->dset < 0 || !ser->buf ||
-                truncate_rows(ser->dset, rows, kind_mem_type(SERIES[i].kind), ser->cols * ser->elem) < 0)
+                truncate_rows(ser->dset, rows, kind_mem_type(bk_series[i].kind), ser->cols * ser->elem) < 0)
                 rc = H5_FAIL(err, "%s: cannot reopen /%s at the checkpoint's %llu rows", w->part,
-                             SERIES[i].name, (unsigned long long)rows);
+                             bk_series[i].name, (unsigned long long)rows);
         }
         if (rc == BK_OK && H5Lexists(w->file, "transitions", H5P_DEFAULT) > 0) {
             w->trans_buf = malloc(TRANSITION_BUFFER * sizeof *w->trans_buf);
@@ -2495,9 +2414,9 @@ static char *expected_datasets(hid_t file)
         return names;
     bk_config *config = NULL;
     bk_error ignored;
-    char list[DATASET_LIST_LEN] = "time,driver,event";
+    char list[BK_DATASET_LIST_LEN] = "time,driver,event";
     if (load_stored_config(file, "", &config, &ignored) == BK_OK)
-        layout_names(config->output.fields, config->model->n_friction_state,
+        bk_output_dataset_names(config->output.fields, config->model->n_friction_state,
                      config->output.transitions, list, sizeof list);
     bk_config_free(config);
     return strdup(list);

@@ -1,0 +1,61 @@
+/* The output layout, described once and free of HDF5: which datasets a run writes, what each
+ * holds (shape, element type, units), the [output] fields words that select them, and the
+ * bytes a row takes on disk (what the [output] max_bytes guard estimates).  The writer, the
+ * verifier, the exporter and the config loader all read this table, so a dataset added here
+ * is created, checked and counted in the size guard at once. */
+#ifndef BKSIM_OUTPUT_LAYOUT_H
+#define BKSIM_OUTPUT_LAYOUT_H
+
+#include <stddef.h>
+
+/* Rows are time-major: T (one value per row), T x N (one per block), T x S (one per
+ * friction-state variable). */
+typedef enum bk_series_shape { BK_SHAPE_T, BK_SHAPE_TN, BK_SHAPE_TS } bk_series_shape;
+typedef enum bk_series_kind { BK_KIND_F64, BK_KIND_U8, BK_KIND_I8 } bk_series_kind;
+
+typedef struct bk_series_def {
+    const char *name;        /* dataset name under the root group */
+    unsigned field;          /* BK_FIELD_* that selects it; 0 = always written */
+    bk_series_shape shape;
+    bk_series_kind kind;
+    const char *units;
+    const char *description;
+} bk_series_def;
+
+/* Indices into bk_series, in the order the datasets are created. */
+enum {
+    BK_SERIES_TIME, BK_SERIES_DRIVER, BK_SERIES_EVENT, BK_SERIES_X, BK_SERIES_V,
+    BK_SERIES_FRICTION, BK_SERIES_COF, BK_SERIES_MODE, BK_SERIES_EKIN, BK_SERIES_EEL,
+    BK_SERIES_WORK, BK_SERIES_DISS, BK_SERIES_STATE, BK_N_SERIES
+};
+
+extern const bk_series_def bk_series[BK_N_SERIES];
+
+/* The words of [output] fields, NULL-terminated: word i selects BK_FIELD bit 1 << i. */
+extern const char *const bk_output_field_names[];
+
+#define BK_TRANSITIONS_UNITS "t: s, block: 1, from: 1, to: 1, x: m, v: m/s, force: N"
+#define BK_TRANSITIONS_DESCRIPTION                                                         \
+    "mode transitions: time, block (0-based), from/to mode (stick 0, slip+ 1, slip- -1), " \
+    "position, velocity after the transition, applied spring force"
+
+/* Whether a run with these output fields and friction states writes this series: the one
+ * rule behind the layout, the list of datasets a reader must find and the size estimate. */
+int bk_series_selected(const bk_series_def *def, unsigned fields, size_t n_state);
+
+/* Values per row of a series in a chain of n_blocks blocks and n_state friction states. */
+size_t bk_series_columns(const bk_series_def *def, size_t n_blocks, size_t n_state);
+
+/* Bytes per value in memory and on disk. */
+size_t bk_series_value_size(bk_series_kind kind);
+
+/* Bytes one time-series row takes on disk (chunk overhead aside). */
+double bk_output_row_bytes(unsigned fields, size_t n_blocks, size_t n_state);
+
+/* The datasets a run of this layout writes, comma-separated (recorded in the root attribute
+ * "datasets" so that a check needs no config to know what must be there). */
+#define BK_DATASET_LIST_LEN 256
+void bk_output_dataset_names(unsigned fields, size_t n_state, int transitions, char *buf,
+                             size_t len);
+
+#endif
