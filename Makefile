@@ -30,8 +30,10 @@ objs = $(patsubst %.c,$(1)/%.o,$(2))
 all: bksim
 
 build/libbksim.a: $(call objs,build,$(LIB_SRC))
+	rm -f $@
 	$(AR) rcs $@ $^
 build-asan/libbksim.a: $(call objs,build-asan,$(LIB_SRC))
+	rm -f $@
 	$(AR) rcs $@ $^
 
 bksim: $(call objs,build,$(CLI_SRC)) build/libbksim.a
@@ -88,7 +90,7 @@ bench: bksim build/bench/bksim_bench
 # corpus lives in build-fuzz/; crashers go to build-fuzz/artifacts/ (keep them as
 # regressions in tests/fuzz/regressions/).
 FUZZ_SECONDS ?= 60
-FUZZ_SRC := $(filter-out src/output/hdf5.c,$(LIB_SRC))
+FUZZ_SRC := $(filter-out src/output/h5_%,$(LIB_SRC))
 # Two harnesses: fuzz_config (text -> model) and fuzz_run (text -> a short run);
 # make fuzz FUZZ_TARGET=fuzz_run.
 FUZZ_TARGET ?= fuzz_config

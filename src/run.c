@@ -24,6 +24,7 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_roots.h>
 
+#include "bksim/checkpoint.h"
 #include "bksim/solver.h"
 #include "method_choice.h"
 #include "prescribed.h"
@@ -273,42 +274,6 @@ static int emit_checkpoint(run_ctx *ctx, double t)
     collect_stats(ctx, &cp.stats, ctx->cpu0);
     int rc = ctx->sink->checkpoint(ctx->sink->self, &cp, ctx->err);
     return rc == BK_OK ? BK_OK : (rc < 0 ? rc : BK_ERR_SINK);
-}
-
-int bk_checkpoint_alloc(bk_checkpoint *cp, size_t n_blocks, size_t n_state)
-{
-    memset(cp, 0, sizeof *cp);
-    cp->n_blocks = n_blocks;
-    cp->n_state = n_state;
-    cp->mode = calloc(n_blocks, sizeof *cp->mode);
-    cp->x = calloc(n_blocks, sizeof *cp->x);
-    cp->v = calloc(n_blocks, sizeof *cp->v);
-    cp->state = calloc(n_state + 1, sizeof *cp->state);
-    cp->t_switch = calloc(n_blocks, sizeof *cp->t_switch);
-    cp->from_rest = calloc(n_blocks, sizeof *cp->from_rest);
-    cp->extremum_armed = calloc(n_blocks, sizeof *cp->extremum_armed);
-    cp->last_transition = calloc(n_blocks, sizeof *cp->last_transition);
-    cp->instant_count = calloc(n_blocks, sizeof *cp->instant_count);
-    if (!cp->mode || !cp->x || !cp->v || !cp->state || !cp->t_switch || !cp->from_rest ||
-        !cp->extremum_armed || !cp->last_transition || !cp->instant_count) {
-        bk_checkpoint_free(cp);
-        return BK_ERR_NOMEM;
-    }
-    return BK_OK;
-}
-
-void bk_checkpoint_free(bk_checkpoint *cp)
-{
-    free(cp->mode);
-    free(cp->x);
-    free(cp->v);
-    free(cp->state);
-    free(cp->t_switch);
-    free(cp->from_rest);
-    free(cp->extremum_armed);
-    free(cp->last_transition);
-    free(cp->instant_count);
-    memset(cp, 0, sizeof *cp);
 }
 
 /* --- integration ----------------------------------------------------------------------- */

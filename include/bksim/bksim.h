@@ -4,9 +4,11 @@
 
 #define BKSIM_VERSION "0.1.0"
 
+#include "bksim/checkpoint.h"
 #include "bksim/config.h"
 #include "bksim/driver.h"
 #include "bksim/friction.h"
+#include "bksim/inspect.h"
 #include "bksim/model.h"
 #include "bksim/modes.h"
 #include "bksim/output.h"

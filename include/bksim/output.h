@@ -1,5 +1,6 @@
-/* HDF5 output: a bk_sink that streams a run to disk, and the readers behind
- * `bksim info` and `bksim export`.
+/* HDF5 output, the write side: a bk_sink that streams a run to disk, checkpoints in it, and
+ * the restart that continues a stopped run.  The read side (`bksim info`, `bksim export`,
+ * the integrity check and the readers) is bksim/inspect.h.
  *
  * Layout (rows are time-major, datasets extendable and chunked; units in a "units"
  * attribute on every dataset):
@@ -22,8 +23,7 @@
 #ifndef BKSIM_OUTPUT_H
 #define BKSIM_OUTPUT_H
 
-#include <stdio.h>
-
+#include "bksim/checkpoint.h"
 #include "bksim/config.h"
 #include "bksim/run.h"
 #include "bksim/status.h"
@@ -66,35 +66,11 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
  * refusing to overwrite restartable work. */
 int bk_h5_restartable(const char *path, double *t_checkpoint, bk_error *err);
 
-/* Summary of an output file: parameters, stick/slip phase counts, solver stats, and the
- * integrity check below.  Returns BK_OK for a complete, intact file, BK_INCOMPLETE for an
- * intact file of a run that did not finish, BK_ERR_DAMAGED (message says what) or another
- * negative code for a file that cannot be read. */
-int bk_h5_info(const char *path, FILE *out, bk_error *err);
-
-/* Integrity: root attributes present; every dataset the writer created (root attribute
- * datasets; for older files, those the stored config selects) present; every time series as
- * long as /time with one column per block where per-block; every value read (so every
- * chunk's Fletcher32 checksum checked), a block of rows at a time: all finite, /mode in
- * {-1, 0, 1}, /event in {0, 1}, /time strictly increasing, t_reached its last value and, for
- * a complete run, /time ending at t_end; /transitions in time order within the run, of
- * existing blocks between valid modes; and a /checkpoint verifying as a restart requires.
- * Same returns as bk_h5_info. */
-int bk_h5_verify(const char *path, bk_error *err);
-
-/* Whitespace-separated columns on out, one row per time sample, after a '#' header naming
- * columns and units.  datasets: comma-separated names (NULL = "time,driver,x,v,friction,
- * cof,mode"); block: column of the T x N datasets to print, or -1 for all blocks.
- * With transitions != 0 prints the /transitions table instead. */
-int bk_h5_export(const char *path, const char *datasets, long block, int transitions,
-                 FILE *out, bk_error *err);
-
-/* Read a whole numeric dataset as doubles (row-major, rows x cols; cols = 1 for 1-D).
- * *data is malloc'ed. */
-int bk_h5_read_doubles(const char *path, const char *dataset, double **data, size_t *rows,
-                       size_t *cols, bk_error *err);
-/* Read /transitions; *rows malloc'ed. */
-int bk_h5_read_transitions(const char *path, bk_transition **rows, size_t *count,
-                           bk_error *err);
+/* While a run writes OUT it is "OUT.part".  bk_output_is_part: whether path ends in
+ * ".part"; bk_output_part_path: path + ".part"; bk_output_final_path: path without its
+ * ".part" (or a copy of path).  Malloc'ed; NULL when out of memory. */
+int bk_output_is_part(const char *path);
+char *bk_output_part_path(const char *path);
+char *bk_output_final_path(const char *path);
 
 #endif

@@ -41,7 +41,8 @@ typedef struct bk_transition {
     double force;  /* N, applied (spring) force on the block at the transition */
 } bk_transition;
 
-struct bk_checkpoint;
+/* A checkpoint (bksim/checkpoint.h): the state a run continues from. */
+typedef struct bk_checkpoint bk_checkpoint;
 
 typedef struct bk_sink {
     void *self;
@@ -49,7 +50,7 @@ typedef struct bk_sink {
     int (*transition)(void *self, const bk_transition *transition, bk_error *err);
     /* At every [output] checkpoint_interval; may be NULL.  The arrays are valid only during
      * the call. */
-    int (*checkpoint)(void *self, const struct bk_checkpoint *checkpoint, bk_error *err);
+    int (*checkpoint)(void *self, const bk_checkpoint *checkpoint, bk_error *err);
 } bk_sink;
 
 typedef struct bk_run_stats {
@@ -72,33 +73,6 @@ typedef struct bk_run_stats {
     double kinetic_change;    /* J */
     double energy_residual;   /* (W - dE_el - dE_kin - D) / max(|W|, tiny), dimensionless */
 } bk_run_stats;
-
-/* Everything a run needs to continue from time t, independent of the solver back-end
- * (which restarts there anyway: a checkpoint is a forced restart, so a resumed run computes
- * exactly what the uninterrupted one did).  Arrays have n_blocks entries (state: n_state). */
-typedef struct bk_checkpoint {
-    double t;                  /* s */
-    size_t n_blocks, n_state;
-    int8_t *mode;              /* bk_mode */
-    double *x, *v;             /* m, m/s */
-    double *state;             /* friction states */
-    double *t_switch;          /* s, when each block last started slipping */
-    uint8_t *from_rest;        /* that slip started at rest */
-    uint8_t *extremum_armed;   /* slip-rate minimum root live */
-    double *last_transition;   /* s, chattering guard */
-    long *instant_count;       /* chattering guard */
-    long next_sample;          /* index of the next sample time */
-    double work_driver, dissipation;         /* J, since t = 0 */
-    double elastic_initial, kinetic_initial; /* J, at t = 0 (for the energy residual) */
-    double t_last_row;         /* s */
-    long steps_since_row;
-    bk_run_stats stats;        /* counters up to t */
-} bk_checkpoint;
-
-/* Allocate the arrays of a checkpoint for n blocks and s states (free with
- * bk_checkpoint_free); BK_ERR_NOMEM on failure. */
-int bk_checkpoint_alloc(bk_checkpoint *checkpoint, size_t n_blocks, size_t n_state);
-void bk_checkpoint_free(bk_checkpoint *checkpoint);
 
 /* Called now and then with the time reached; return non-zero to stop the run. */
 typedef int (*bk_progress_fn)(void *user, double t, double t_end);

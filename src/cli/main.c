@@ -292,10 +292,7 @@ static int cmd_run(int argc, char **argv)
     int opened;
     if (args.restart) {
         opened = bk_h5_writer_resume(&writer, args.restart, &config, &checkpoint, &err);
-        /* The final name: the .part without its suffix. */
-        size_t len = strlen(args.restart);
-        restart_path = len > 5 && strcmp(args.restart + len - 5, ".part") == 0 ? strndup(args.restart, len - 5)
-                                                                                 : strdup(args.restart);
+        restart_path = bk_output_final_path(args.restart);
         path = restart_path;
     } else {
         /* A stopped run's progress is not thrown away by running the same command again. */

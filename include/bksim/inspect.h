@@ -1,0 +1,44 @@
+/* HDF5 output, the read side: the summary and integrity check behind `bksim info`, the text
+ * export behind `bksim export`, and whole-dataset readers.  The file layout is described in
+ * bksim/output.h (the write side). */
+#ifndef BKSIM_INSPECT_H
+#define BKSIM_INSPECT_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "bksim/run.h"
+#include "bksim/status.h"
+
+/* Summary of an output file: parameters, stick/slip phase counts, solver stats, and the
+ * integrity check below.  Returns BK_OK for a complete, intact file, BK_INCOMPLETE for an
+ * intact file of a run that did not finish, BK_ERR_DAMAGED (message says what) or another
+ * negative code for a file that cannot be read. */
+int bk_h5_info(const char *path, FILE *out, bk_error *err);
+
+/* Integrity: root attributes present; every dataset the writer created (root attribute
+ * datasets; for older files, those the stored config selects) present; every time series as
+ * long as /time with one column per block where per-block; every value read (so every
+ * chunk's Fletcher32 checksum checked), a block of rows at a time: all finite, /mode in
+ * {-1, 0, 1}, /event in {0, 1}, /time strictly increasing, t_reached its last value and, for
+ * a complete run, /time ending at t_end; /transitions in time order within the run, of
+ * existing blocks between valid modes; and a /checkpoint verifying as a restart requires.
+ * Same returns as bk_h5_info. */
+int bk_h5_verify(const char *path, bk_error *err);
+
+/* Whitespace-separated columns on out, one row per time sample, after a '#' header naming
+ * columns and units.  datasets: comma-separated names (NULL = "time,driver,x,v,friction,
+ * cof,mode"); block: column of the T x N datasets to print, or -1 for all blocks.
+ * With transitions != 0 prints the /transitions table instead. */
+int bk_h5_export(const char *path, const char *datasets, long block, int transitions,
+                 FILE *out, bk_error *err);
+
+/* Read a whole numeric dataset as doubles (row-major, rows x cols; cols = 1 for 1-D).
+ * *data is malloc'ed. */
+int bk_h5_read_doubles(const char *path, const char *dataset, double **data, size_t *rows,
+                       size_t *cols, bk_error *err);
+/* Read /transitions; *rows malloc'ed. */
+int bk_h5_read_transitions(const char *path, bk_transition **rows, size_t *count,
+                           bk_error *err);
+
+#endif

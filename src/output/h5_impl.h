@@ -1,0 +1,195 @@
+/* What the HDF5 files of src/output/ share and nothing outside them sees: the writer's
+ * state, the error plumbing, attribute helpers and the low-level readers.  Public entry
+ * points are in include/bksim/output.h (write side) and include/bksim/inspect.h (read
+ * side); the file layout itself is in layout.h, free of HDF5.
+ *
+ * Failures are reported through bk_error only: HDF5's automatic error printing is switched
+ * off at every entry point, and the innermost message of HDF5's error stack is appended to
+ * ours because it usually names the real cause (errno text, "file is truncated", ...). */
+#ifndef BKSIM_OUTPUT_H5_IMPL_H
+#define BKSIM_OUTPUT_H5_IMPL_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include <hdf5.h>
+
+#include "bksim/checkpoint.h"
+#include "bksim/config.h"
+#include "bksim/output.h"
+#include "output/layout.h"
+
+/* Rows buffered in memory before an append; also the row count of a 2-D chunk.  A chunk
+ * of a T x N dataset is capped at CHUNK_BYTES so wide chains keep chunks (and the buffers,
+ * one chunk per dataset) bounded. */
+#define MAX_BUFFER_ROWS 512u
+#define CHUNK_BYTES (1u << 20)
+/* 1-D series are tiny per row; longer chunks keep the chunk index small on long runs.
+ * Appends of fewer rows go through the per-dataset chunk cache (1 MiB by default). */
+#define SERIES_1D_CHUNK 4096u
+#define TRANSITION_BUFFER 512u
+/* Doubles held in memory per block of rows while exporting or checking. */
+#define EXPORT_BUDGET (1u << 20)
+
+/* ------------------------------------------------------------------ the writer --- */
+
+typedef struct bk_h5_series {
+    hid_t dset;          /* H5I_INVALID_HID when the field is not written */
+    int rank;            /* 1 for T, 2 for T x N and T x S */
+    size_t cols;         /* values per row */
+    size_t elem;         /* bytes per value in memory */
+    unsigned char *buf;  /* buffer_rows x cols values */
+} bk_h5_series;
+
+struct bk_h5_writer {
+    char *path;
+    char *part;
+    hid_t file;
+    size_t n_blocks;
+    bk_h5_series s[BK_N_SERIES];
+    size_t buffer_rows;
+    size_t buffered;
+    hsize_t rows_written;
+    double t_buffered;   /* time of the last row handed to the sink */
+    double t_written;    /* time of the last row on disk */
+    hid_t trans_dset;
+    hid_t trans_mem;
+    bk_transition *trans_buf;
+    size_t trans_buffered;
+    hsize_t trans_written;
+    double trans_last_t; /* t of the last transition on disk */
+    long long cp_sequence; /* of the last checkpoint written (0: none) */
+    int cp_slot;         /* slot of /checkpoint the next checkpoint goes to */
+    int failed;          /* a write failed: rows on disk may be ragged, accept no more */
+};
+
+/* The one set-up shared by a new run (bk_h5_writer_open) and a resumed one
+ * (bk_h5_writer_resume): a writer for the final name path, its .part name, every id
+ * invalid.  BK_ERR_NOMEM on failure (message names path). */
+int bk_h5_writer_new(bk_h5_writer **out, const char *path, bk_error *err);
+/* Size the row buffers for this chain: how many rows a buffer holds. */
+void bk_h5_writer_size(bk_h5_writer *w, const bk_model *model);
+/* Shape series i for this chain and allocate its row buffer; -1 when out of memory. */
+int bk_h5_writer_series(bk_h5_writer *w, int i, const bk_model *model);
+/* The transition buffer and its memory type; -1 on failure. */
+int bk_h5_writer_transition_buffer(bk_h5_writer *w);
+/* Close every id the writer holds; -1 if any close failed. */
+herr_t bk_h5_writer_close(bk_h5_writer *w);
+void bk_h5_writer_free(bk_h5_writer *w);
+/* Write buffered rows and transitions and flush HDF5's metadata (see h5_writer.c). */
+int bk_h5_writer_flush(bk_h5_writer *w, bk_error *err);
+/* The solver statistics as attributes of group "stats" in obj. */
+herr_t bk_h5_write_stats(hid_t obj, const bk_run_stats *stats);
+/* The sink's checkpoint callback (h5_checkpoint.c). */
+int bk_h5_sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err);
+
+/* ------------------------------------------------------------ error plumbing --- */
+
+/* Our message plus the most specific description on HDF5's error stack, which must still
+ * hold the failure: call this before any further HDF5 call (closing ids clears it). */
+int bk_h5_fail(bk_error *err, int status, const char *file, int line, const char *func,
+               const char *fmt, ...) __attribute__((format(printf, 6, 7)));
+
+#define H5_FAIL(err, ...) bk_h5_fail((err), BK_ERR_HDF5, __FILE__, __LINE__, __func__, __VA_ARGS__)
+/* A read that failed inside a file that opened: the file is damaged (a Fletcher32 checksum
+ * mismatch lands here), and HDF5's reason is kept. */
+#define H5_DAMAGED(err, ...) \
+    bk_h5_fail((err), BK_ERR_DAMAGED, __FILE__, __LINE__, __func__, __VA_ARGS__)
+
+void bk_h5_close_id(hid_t id);
+/* Close ids after a helper finished.  Closing clears HDF5's error stack, so after a failure
+ * the stack is saved first and restored, leaving it for bk_h5_fail in the caller. */
+void bk_h5_close_ids(int failed, const hid_t *ids, size_t n);
+
+#define CLOSE_IDS(status, ...)                                  \
+    bk_h5_close_ids((status) < 0, (const hid_t[]){__VA_ARGS__}, \
+                    sizeof((const hid_t[]){__VA_ARGS__}) / sizeof(hid_t))
+
+htri_t bk_h5_has_signature(const char *path);
+
+/* ---------------------------------------------------------------- attributes --- */
+
+herr_t bk_h5_write_attr(hid_t obj, const char *name, hid_t file_type, hid_t mem_type,
+                        const void *value);
+herr_t bk_h5_write_string_attr(hid_t obj, const char *name, const char *value);
+herr_t bk_h5_write_fixed_string_attr(hid_t obj, const char *name, const char *value);
+herr_t bk_h5_write_double_attr(hid_t obj, const char *name, double value);
+herr_t bk_h5_write_int_attr(hid_t obj, const char *name, int value);
+herr_t bk_h5_write_long_attr(hid_t obj, const char *name, long long value);
+/* "units" and "description" attributes: variable-length (at creation) or fixed-length (on
+ * objects written later; see bk_h5_write_fixed_string_attr). */
+herr_t bk_h5_describe(hid_t obj, const char *units, const char *description);
+herr_t bk_h5_describe_fixed(hid_t obj, const char *units, const char *description);
+char *bk_h5_read_string_attr(hid_t obj, const char *name);
+herr_t bk_h5_read_numeric_attr(hid_t obj, const char *name, hid_t mem_type, void *value);
+
+/* --------------------------------------------------------------------- types --- */
+
+hid_t bk_h5_kind_file_type(bk_series_kind kind);
+hid_t bk_h5_kind_mem_type(bk_series_kind kind);
+/* The transition record in memory (bk_transition) or on disk (packed little-endian). */
+hid_t bk_h5_transition_type(int on_disk);
+
+/* ------------------------------------------------------------------- readers --- */
+
+/* Open path read-only with a message that says what is wrong (missing, a directory, not
+ * HDF5, a .part cut short). */
+int bk_h5_open_input(const char *path, hid_t *file, bk_error *err);
+int bk_h5_read_n_blocks(hid_t file, const char *path, long long *n_blocks, bk_error *err);
+/* Opens a numeric 1-D or 2-D dataset and reports its shape. */
+int bk_h5_open_series(hid_t file, const char *path, const char *name, hid_t *dset,
+                      hsize_t *rows, hsize_t *cols, int *rank, bk_error *err);
+/* Opens /transitions and its memory type; count = rows. */
+int bk_h5_open_transitions(hid_t file, const char *path, hid_t *dset, hid_t *mem,
+                           hsize_t *count, bk_error *err);
+/* Rows [start, start + count) and columns [col, col + ncols) as mem_type. */
+herr_t bk_h5_read_block(hid_t dset, int rank, hsize_t start, hsize_t count, hsize_t col,
+                        hsize_t ncols, hid_t mem_type, void *buf);
+herr_t bk_h5_read_block_xfer(hid_t dset, int rank, hsize_t start, hsize_t count, hsize_t col,
+                             hsize_t ncols, hid_t mem_type, void *buf, hid_t dxpl);
+/* First-dimension chunk size of a chunked dataset; 0 when not chunked. */
+hsize_t bk_h5_chunk_rows(hid_t dset);
+
+typedef struct bk_h5_name_list {
+    char **names;
+    size_t count;
+} bk_h5_name_list;
+
+/* Root datasets a time-series export can print (numeric, 1-D or 2-D), in creation order
+ * when the file tracks it (ours do), else by name; -1 on failure. */
+int bk_h5_list_series(hid_t file, bk_h5_name_list *list);
+void bk_h5_name_list_free(bk_h5_name_list *list);
+
+/* The datasets the writer created, from the root attribute "datasets"; NULL for a file
+ * written before it was recorded.  Malloc'ed, comma-separated. */
+char *bk_h5_recorded_datasets(hid_t file);
+/* Every name in the comma-separated list is a link in file; else BK_ERR_DAMAGED. */
+int bk_h5_require_datasets(hid_t file, const char *path, const char *names, bk_error *err);
+/* The config a run stored (file text and --set overrides, any number of them). */
+int bk_h5_load_stored_config(hid_t file, const char *path, bk_config **config, bk_error *err);
+
+/* --------------------------------------------------------------- checkpoints --- */
+
+/* A checkpoint read back from a slot of /checkpoint. */
+typedef struct bk_h5_slot {
+    bk_checkpoint checkpoint;   /* owned: bk_checkpoint_free */
+    bk_checkpoint_record record;
+    int index;                  /* 0: /checkpoint/a, 1: /checkpoint/b */
+    int legacy;                 /* /checkpoint is an older bksim's, without a record */
+} bk_h5_slot;
+
+/* The newest slot of /checkpoint that verifies (checksum, row counts on disk, /time at its
+ * last row), for a run of n_blocks blocks.  BK_ERR_INVALID when the file has no
+ * /checkpoint, or only a first one cut short; BK_ERR_DAMAGED when no slot verifies (the
+ * message gives each slot's fault), or when /checkpoint was written without a consistency
+ * record (legacy set: an older bksim's, which cannot be verified). */
+int bk_h5_find_checkpoint(hid_t file, const char *path, size_t n_blocks, bk_h5_slot *found,
+                          bk_error *err);
+
+/* ------------------------------------------------------------------- verify --- */
+
+/* The integrity check on an open file (see bk_h5_verify). */
+int bk_h5_verify_open(hid_t file, const char *path, bk_error *err);
+
+#endif

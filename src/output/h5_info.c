@@ -1,0 +1,268 @@
+/* `bksim info`: a file's parameters, stick and slip phases per block, solver statistics and
+ * the verdict of the integrity check (h5_verify.c). */
+#include "bksim/inspect.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "output/h5_impl.h"
+
+/* Unit of key in a "key: unit, key: unit" list; "" when not listed. */
+static void unit_of(const char *units, const char *key, char *buf, size_t len)
+{
+    buf[0] = '\0';
+    if (!units)
+        return;
+    size_t key_len = strlen(key);
+    for (const char *p = units; *p;) {
+        while (*p == ' ' || *p == ',')
+            ++p;
+        const char *end = strchr(p, ',');
+        if (!end)
+            end = p + strlen(p);
+        if ((size_t)(end - p) > key_len + 1 && strncmp(p, key, key_len) == 0 &&
+            p[key_len] == ':') {
+            const char *u = p + key_len + 1;
+            while (*u == ' ')
+                ++u;
+            snprintf(buf, len, "%.*s", (int)(end - u), u);
+            return;
+        }
+        p = end;
+    }
+}
+
+typedef struct stats_print {
+    FILE *out;
+    char *units;
+} stats_print;
+
+static herr_t print_stat(hid_t group, const char *name, const H5A_info_t *info, void *data)
+{
+    const stats_print *ctx = data;
+    (void)info;
+    if (strcmp(name, "units") == 0 || strcmp(name, "description") == 0)
+        return 0;
+    hid_t attr = H5Aopen(group, name, H5P_DEFAULT);
+    hid_t type = attr >= 0 ? H5Aget_type(attr) : H5I_INVALID_HID;
+    H5T_class_t cls = type >= 0 ? H5Tget_class(type) : H5T_NO_CLASS;
+    CLOSE_IDS(0, type, attr);
+    /* Counts carry unit "1"; printing it after every count would only be noise. */
+    char unit[64];
+    unit_of(ctx->units, name, unit, sizeof unit);
+    if (strcmp(unit, "1") == 0)
+        unit[0] = '\0';
+    const char *sep = unit[0] ? " " : "";
+    if (cls == H5T_STRING) {
+        char *text = bk_h5_read_string_attr(group, name);
+        fprintf(ctx->out, "    %-18s %s\n", name, text ? text : "?");
+        free(text);
+    } else if (cls == H5T_INTEGER) {
+        long long value = 0;
+        if (bk_h5_read_numeric_attr(group, name, H5T_NATIVE_LLONG, &value) >= 0)
+            fprintf(ctx->out, "    %-18s %lld%s%s\n", name, value, sep, unit);
+    } else if (cls == H5T_FLOAT) {
+        double value = 0;
+        if (bk_h5_read_numeric_attr(group, name, H5T_NATIVE_DOUBLE, &value) >= 0)
+            fprintf(ctx->out, "    %-18s %.9g%s%s\n", name, value, sep, unit);
+    }
+    return 0;
+}
+
+static void print_stats(hid_t file, FILE *out)
+{
+    if (H5Lexists(file, "stats", H5P_DEFAULT) <= 0) {
+        fprintf(out, "stats: none recorded\n");
+        return;
+    }
+    hid_t group = H5Gopen2(file, "stats", H5P_DEFAULT);
+    if (group < 0) {
+        fprintf(out, "stats: unreadable\n");
+        return;
+    }
+    stats_print ctx = {out, bk_h5_read_string_attr(group, "units")};
+    fprintf(out, "stats:\n");
+    hsize_t idx = 0;
+    if (H5Aiterate2(group, H5_INDEX_CRT_ORDER, H5_ITER_INC, &idx, print_stat, &ctx) < 0 &&
+        idx == 0) {
+        /* Files whose /stats does not track creation order: alphabetical. */
+        idx = 0;
+        H5Aiterate2(group, H5_INDEX_NAME, H5_ITER_INC, &idx, print_stat, &ctx);
+    }
+    free(ctx.units);
+    bk_h5_close_id(group);
+}
+
+static void print_indented(FILE *out, const char *text)
+{
+    const char *p = text;
+    while (*p) {
+        const char *end = strchr(p, '\n');
+        size_t len = end ? (size_t)(end - p) : strlen(p);
+        fprintf(out, "    %.*s\n", (int)len, p);
+        p += len + (end ? 1 : 0);
+    }
+}
+
+/* Stick and slip phases per block: each transition starts a phase of its `to` mode, and
+ * row 0 of /mode starts the first one. */
+static int count_phases(hid_t file, const char *path, size_t n_blocks, long *stick, long *slip,
+                        long *total, int *have_transitions, bk_error *err)
+{
+    hid_t dset, mem;
+    hsize_t rows, cols;
+    int rank;
+    *total = 0;
+    *have_transitions = 0;
+    if (H5Lexists(file, "mode", H5P_DEFAULT) > 0 &&
+        bk_h5_open_series(file, path, "mode", &dset, &rows, &cols, &rank, NULL) == BK_OK) {
+        if (rows > 0 && rank == 2 && cols == n_blocks) {
+            int8_t *first = malloc(n_blocks);
+            if (first && bk_h5_read_block(dset, 2, 0, 1, 0, cols, H5T_NATIVE_INT8, first) >= 0)
+                for (size_t i = 0; i < n_blocks; ++i)
+                    ++*(first[i] == 0 ? &stick[i] : &slip[i]);
+            free(first);
+        }
+        bk_h5_close_id(dset);
+    }
+    if (H5Lexists(file, "transitions", H5P_DEFAULT) <= 0)
+        return BK_OK;
+    hsize_t count;
+    int rc = bk_h5_open_transitions(file, path, &dset, &mem, &count, err);
+    if (rc != BK_OK)
+        return rc;
+    *have_transitions = 1;
+    bk_transition *buf = malloc(TRANSITION_BUFFER * sizeof *buf);
+    if (!buf)
+        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    for (hsize_t start = 0; rc == BK_OK && start < count; start += TRANSITION_BUFFER) {
+        size_t n = (size_t)(count - start);
+        if (n > TRANSITION_BUFFER)
+            n = TRANSITION_BUFFER;
+        if (bk_h5_read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
+            rc = H5_DAMAGED(err, "%s: damaged: /transitions cannot be read", path);
+            break;
+        }
+        for (size_t k = 0; k < n; ++k) {
+            if (buf[k].block < 0 || (size_t)buf[k].block >= n_blocks) {
+                rc = BK_FAIL(err, BK_ERR_DAMAGED,
+                             "%s: damaged: /transitions row %llu names block %d, outside 0..%zu", path,
+                             (unsigned long long)(start + k), (int)buf[k].block, n_blocks - 1);
+                break;
+            }
+            ++*(buf[k].to == 0 ? &stick[buf[k].block] : &slip[buf[k].block]);
+        }
+    }
+    *total = (long)count;
+    free(buf);
+    CLOSE_IDS(0, mem, dset);
+    return rc;
+}
+
+int bk_h5_info(const char *path, FILE *out, bk_error *err)
+{
+    hid_t file;
+    int rc = bk_h5_open_input(path, &file, err);
+    if (rc != BK_OK)
+        return rc;
+    long long n_blocks = 0;
+    rc = bk_h5_read_n_blocks(file, path, &n_blocks, err);
+    long *stick = NULL, *slip = NULL;
+    long total = 0;
+    int have_transitions = 0;
+    if (rc == BK_OK) {
+        stick = calloc((size_t)n_blocks, sizeof *stick);
+        slip = calloc((size_t)n_blocks, sizeof *slip);
+        if (!stick || !slip)
+            rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    }
+    /* Phases that cannot be counted (a damaged /transitions) still leave a summary; the
+     * integrity check below names the damage. */
+    bk_error phase_err = {0};
+    int phases = rc == BK_OK ? count_phases(file, path, (size_t)n_blocks, stick, slip, &total,
+                                            &have_transitions, &phase_err)
+                             : rc;
+    if (phases == BK_ERR_NOMEM) {
+        rc = phases;
+        if (err)
+            *err = phase_err;
+    }
+    if (rc != BK_OK) {
+        free(stick);
+        free(slip);
+        bk_h5_close_id(file);
+        return rc;
+    }
+
+    char *name = bk_h5_read_string_attr(file, "config_name");
+    char *version = bk_h5_read_string_attr(file, "version");
+    char *config = bk_h5_read_string_attr(file, "config");
+    char *error = bk_h5_read_string_attr(file, "error");
+    int complete = 0;
+    double t_end = NAN, t_reached = NAN;
+    int have_complete = bk_h5_read_numeric_attr(file, "complete", H5T_NATIVE_INT, &complete) >= 0;
+    bk_h5_read_numeric_attr(file, "t_end", H5T_NATIVE_DOUBLE, &t_end);
+    bk_h5_read_numeric_attr(file, "t_reached", H5T_NATIVE_DOUBLE, &t_reached);
+    hsize_t rows = 0, cols;
+    int rank;
+    hid_t time;
+    int have_rows = H5Lexists(file, "time", H5P_DEFAULT) > 0 &&
+                    bk_h5_open_series(file, path, "time", &time, &rows, &cols, &rank, NULL) == BK_OK;
+    if (have_rows)
+        bk_h5_close_id(time);
+
+    fprintf(out, "file         %s\n", path);
+    fprintf(out, "config name  %s\n", name ? name : "?");
+    fprintf(out, "version      %s\n", version ? version : "?");
+    if (have_complete)
+        fprintf(out, "complete     %d%s\n", complete, complete ? "" : " (run did not finish)");
+    else
+        fprintf(out, "complete     ?\n");
+    if (error)
+        fprintf(out, "error        %s\n", error);
+    fprintf(out, "t_end        %.9g s\n", t_end);
+    fprintf(out, "t_reached    %.9g s\n", t_reached);
+    fprintf(out, "n_blocks     %lld\n", n_blocks);
+    if (have_rows)
+        fprintf(out, "rows         %llu\n", (unsigned long long)rows);
+    else
+        fprintf(out, "rows         ? (no /time)\n");
+    fprintf(out, "config:\n");
+    print_indented(out, config ? config : "(not stored)");
+    if (phases != BK_OK) {
+        fprintf(out, "phases per block: not counted (%s)\n", phase_err.message);
+    } else {
+        fprintf(out, "phases per block:\n");
+        for (long long i = 0; i < n_blocks; ++i)
+            fprintf(out, "    block %lld: %ld stick, %ld slip\n", i, stick[i], slip[i]);
+    }
+    if (phases != BK_OK && have_transitions)
+        fprintf(out, "transitions  %ld (not all readable)\n", total);
+    else if (have_transitions)
+        fprintf(out, "transitions  %ld\n", total);
+    else
+        fprintf(out, "transitions  not recorded\n");
+    print_stats(file, out);
+    bk_error check = {0};
+    int integrity = bk_h5_verify_open(file, path, &check);
+    if (integrity == BK_OK)
+        fprintf(out, "integrity    ok\n");
+    else if (integrity == BK_INCOMPLETE)
+        fprintf(out, "integrity    intact, but the run did not finish (complete = 0)\n");
+    else
+        fprintf(out, "integrity    DAMAGED: %s\n", check.message);
+
+    free(name);
+    free(version);
+    free(config);
+    free(error);
+    free(stick);
+    free(slip);
+    bk_h5_close_id(file);
+    if (ferror(out))
+        return BK_FAIL(err, BK_ERR_IO, "%s: writing the summary failed", path);
+    if (integrity < 0 && err)
+        *err = check;
+    return integrity;
+}

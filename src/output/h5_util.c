@@ -1,0 +1,347 @@
+/* HDF5 plumbing shared by the writer, the checkpoint slots and the readers: error messages
+ * that keep HDF5's own reason, closing ids without losing it, scalar attributes, and the
+ * HDF5 types of the layout's value kinds and of the transition record. */
+#include "output/h5_impl.h"
+
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define DETAIL_LEN 256
+
+/* ---------------------------------------------------------------- error plumbing --- */
+
+/* HDF5's file-driver messages carry timestamps, descriptors and buffer addresses; of
+ * those only the operation and the system's error text help the user. */
+static void condense(const char *desc, char *out, size_t len)
+{
+    const char *marker = "error message = '";
+    const char *text = strstr(desc, marker);
+    if (text) {
+        text += strlen(marker);
+        const char *text_end = strchr(text, '\'');
+        const char *colon = strchr(desc, ':');
+        int op_len = colon && colon < text ? (int)(colon - desc) : 0;
+        int text_len = text_end ? (int)(text_end - text) : (int)strlen(text);
+        if (op_len > 0)
+            snprintf(out, len, "%.*s: %.*s", op_len, desc, text_len, text);
+        else
+            snprintf(out, len, "%.*s", text_len, text);
+    } else {
+        snprintf(out, len, "%s", desc);
+    }
+    for (char *p = out; *p; ++p)
+        if (*p == '\n')
+            *p = ' ';
+}
+
+static herr_t innermost_error(unsigned n, const H5E_error2_t *e, void *data)
+{
+    char *detail = data;
+    (void)n;
+    if (detail[0] == '\0' && e->desc && e->desc[0])
+        condense(e->desc, detail, DETAIL_LEN);
+    return 0;
+}
+
+int bk_h5_fail(bk_error *err, int status, const char *file, int line, const char *func,
+                   const char *fmt, ...)
+{
+    char detail[DETAIL_LEN] = "";
+    H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, innermost_error, detail);
+    char message[BK_ERROR_MESSAGE_LEN];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(message, sizeof message, fmt, ap);
+    va_end(ap);
+    if (detail[0])
+        return bk_error_set(err, status, file, line, func, "%s (HDF5: %s)", message, detail);
+    return bk_error_set(err, status, file, line, func, "%s", message);
+}
+
+void bk_h5_close_id(hid_t id)
+{
+    if (id < 0)
+        return;
+    switch (H5Iget_type(id)) {
+    case H5I_FILE:
+        H5Fclose(id);
+        break;
+    case H5I_GROUP:
+        H5Gclose(id);
+        break;
+    case H5I_DATASET:
+        H5Dclose(id);
+        break;
+    case H5I_ATTR:
+        H5Aclose(id);
+        break;
+    case H5I_DATATYPE:
+        H5Tclose(id);
+        break;
+    case H5I_DATASPACE:
+        H5Sclose(id);
+        break;
+    case H5I_GENPROP_LST:
+        H5Pclose(id);
+        break;
+    default:
+        break;
+    }
+}
+
+void bk_h5_close_ids(int failed, const hid_t *ids, size_t n)
+{
+    hid_t stack = failed ? H5Eget_current_stack() : H5I_INVALID_HID;
+    for (size_t i = 0; i < n; ++i)
+        bk_h5_close_id(ids[i]);
+    if (stack >= 0)
+        H5Eset_current_stack(stack);
+}
+
+/* H5Fis_hdf5 is deprecated from HDF5 1.12 on. */
+htri_t bk_h5_has_signature(const char *path)
+{
+#if H5_VERSION_GE(1, 12, 0)
+    return H5Fis_accessible(path, H5P_DEFAULT);
+#else
+    return H5Fis_hdf5(path);
+#endif
+}
+
+/* ------------------------------------------------------------------ attributes --- */
+
+/* Create or overwrite a scalar attribute. */
+herr_t bk_h5_write_attr(hid_t obj, const char *name, hid_t file_type, hid_t mem_type,
+                         const void *value)
+{
+    hid_t space = H5I_INVALID_HID, attr = H5I_INVALID_HID;
+    herr_t rc = -1;
+    htri_t exists = H5Aexists(obj, name);
+    if (exists < 0)
+        goto done;
+    if (exists) {
+        attr = H5Aopen(obj, name, H5P_DEFAULT);
+    } else {
+        space = H5Screate(H5S_SCALAR);
+        if (space < 0)
+            goto done;
+        attr = H5Acreate2(obj, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT);
+    }
+    if (attr < 0)
+        goto done;
+    rc = H5Awrite(attr, mem_type, value);
+done:
+    CLOSE_IDS(rc, attr, space);
+    return rc;
+}
+
+/* Variable-length UTF-8 strings: no size limit (the config text can be long), and h5py
+ * reads them as str. */
+static hid_t vlen_string_type(void)
+{
+    hid_t type = H5Tcopy(H5T_C_S1);
+    if (type < 0)
+        return type;
+    if (H5Tset_size(type, H5T_VARIABLE) < 0 || H5Tset_cset(type, H5T_CSET_UTF8) < 0) {
+        CLOSE_IDS(-1, type);
+        return H5I_INVALID_HID;
+    }
+    return type;
+}
+
+herr_t bk_h5_write_string_attr(hid_t obj, const char *name, const char *value)
+{
+    const char *text = value ? value : "";
+    hid_t type = vlen_string_type();
+    herr_t rc = type < 0 ? -1 : bk_h5_write_attr(obj, name, type, type, &text);
+    CLOSE_IDS(rc, type);
+    return rc;
+}
+
+/* A fixed-length UTF-8 string attribute, created or replaced.  Every string written after
+ * the file is created is one of these: a variable-length string lives in HDF5's global
+ * heap, and a kill while a rewrite of the heap is flushed can leave it in a state that
+ * HDF5 1.10 reads in an endless loop (seen with the checkpoint's method string, rewritten at
+ * every checkpoint: `bksim info` hung).  Fixed-length text sits in the attribute itself,
+ * inside the object header, so after the first flush the heap is never written again. */
+herr_t bk_h5_write_fixed_string_attr(hid_t obj, const char *name, const char *value)
+{
+    const char *text = value ? value : "";
+    size_t len = strlen(text);
+    hid_t type = H5Tcopy(H5T_C_S1);
+    herr_t rc = type < 0 || H5Tset_size(type, len ? len : 1) < 0 ||
+                        H5Tset_cset(type, H5T_CSET_UTF8) < 0 ||
+                        H5Tset_strpad(type, H5T_STR_NULLPAD) < 0
+                    ? -1
+                    : 0;
+    htri_t exists = rc < 0 ? -1 : H5Aexists(obj, name);
+    if (exists < 0)
+        rc = -1;
+    if (exists > 0) {
+        /* Another length (or a variable-length attribute of an older file): replace it. */
+        hid_t attr = H5Aopen(obj, name, H5P_DEFAULT);
+        hid_t old = attr < 0 ? H5I_INVALID_HID : H5Aget_type(attr);
+        int same = old >= 0 && H5Tequal(old, type) > 0;
+        CLOSE_IDS(0, old, attr);
+        if (!same && H5Adelete(obj, name) < 0)
+            rc = -1;
+    }
+    if (rc >= 0)
+        rc = bk_h5_write_attr(obj, name, type, type, text);
+    CLOSE_IDS(rc, type);
+    return rc;
+}
+
+herr_t bk_h5_write_double_attr(hid_t obj, const char *name, double value)
+{
+    return bk_h5_write_attr(obj, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
+}
+
+herr_t bk_h5_write_int_attr(hid_t obj, const char *name, int value)
+{
+    return bk_h5_write_attr(obj, name, H5T_STD_I32LE, H5T_NATIVE_INT, &value);
+}
+
+herr_t bk_h5_write_long_attr(hid_t obj, const char *name, long long value)
+{
+    return bk_h5_write_attr(obj, name, H5T_STD_I64LE, H5T_NATIVE_LLONG, &value);
+}
+
+herr_t bk_h5_describe(hid_t obj, const char *units, const char *description)
+{
+    if (bk_h5_write_string_attr(obj, "units", units) < 0)
+        return -1;
+    return bk_h5_write_string_attr(obj, "description", description);
+}
+
+/* The same for objects written after the file was created (see bk_h5_write_fixed_string_attr). */
+herr_t bk_h5_describe_fixed(hid_t obj, const char *units, const char *description)
+{
+    if (bk_h5_write_fixed_string_attr(obj, "units", units) < 0)
+        return -1;
+    return bk_h5_write_fixed_string_attr(obj, "description", description);
+}
+
+/* A string attribute written as variable- or fixed-length; NULL when absent or not a
+ * scalar string.  Malloc'ed. */
+char *bk_h5_read_string_attr(hid_t obj, const char *name)
+{
+    hid_t attr = H5I_INVALID_HID, type = H5I_INVALID_HID, space = H5I_INVALID_HID;
+    hid_t mem = H5I_INVALID_HID;
+    char *result = NULL;
+    if (H5Aexists(obj, name) <= 0)
+        return NULL;
+    attr = H5Aopen(obj, name, H5P_DEFAULT);
+    if (attr < 0)
+        goto done;
+    type = H5Aget_type(attr);
+    space = H5Aget_space(attr);
+    if (type < 0 || space < 0 || H5Tget_class(type) != H5T_STRING ||
+        H5Sget_simple_extent_npoints(space) != 1)
+        goto done;
+    htri_t variable = H5Tis_variable_str(type);
+    if (variable > 0) {
+        mem = vlen_string_type();
+        char *text = NULL;
+        if (mem >= 0 && H5Aread(attr, mem, &text) >= 0 && text) {
+            result = strdup(text);
+            H5free_memory(text);
+        }
+    } else if (variable == 0) {
+        size_t size = H5Tget_size(type);
+        result = size > 0 ? calloc(size + 1, 1) : NULL;
+        if (result && H5Aread(attr, type, result) < 0) {
+            free(result);
+            result = NULL;
+        }
+    }
+done:
+    CLOSE_IDS(result ? 0 : -1, mem, space, type, attr);
+    return result;
+}
+
+/* A numeric scalar attribute converted to the native type mem_type; -1 when absent. */
+herr_t bk_h5_read_numeric_attr(hid_t obj, const char *name, hid_t mem_type, void *value)
+{
+    hid_t attr = H5I_INVALID_HID, type = H5I_INVALID_HID, space = H5I_INVALID_HID;
+    herr_t rc = -1;
+    if (H5Aexists(obj, name) <= 0)
+        return -1;
+    attr = H5Aopen(obj, name, H5P_DEFAULT);
+    if (attr < 0)
+        goto done;
+    type = H5Aget_type(attr);
+    space = H5Aget_space(attr);
+    if (type < 0 || space < 0 || H5Sget_simple_extent_npoints(space) != 1)
+        goto done;
+    H5T_class_t cls = H5Tget_class(type);
+    if (cls != H5T_INTEGER && cls != H5T_FLOAT)
+        goto done;
+    rc = H5Aread(attr, mem_type, value);
+done:
+    CLOSE_IDS(rc, space, type, attr);
+    return rc;
+}
+
+/* ----------------------------------------------------------------------- types --- */
+
+hid_t bk_h5_kind_file_type(bk_series_kind kind)
+{
+    switch (kind) {
+    case BK_KIND_U8:
+        return H5T_STD_U8LE;
+    case BK_KIND_I8:
+        return H5T_STD_I8LE;
+    case BK_KIND_F64:
+        break;
+    }
+    return H5T_IEEE_F64LE;
+}
+
+hid_t bk_h5_kind_mem_type(bk_series_kind kind)
+{
+    switch (kind) {
+    case BK_KIND_U8:
+        return H5T_NATIVE_UINT8;
+    case BK_KIND_I8:
+        return H5T_NATIVE_INT8;
+    case BK_KIND_F64:
+        break;
+    }
+    return H5T_NATIVE_DOUBLE;
+}
+
+/* The transition record in memory (bk_transition) and on disk (packed little-endian). */
+hid_t bk_h5_transition_type(int on_disk)
+{
+    hid_t type = H5Tcreate(H5T_COMPOUND, on_disk ? 38 : sizeof(bk_transition));
+    if (type < 0)
+        return type;
+    herr_t rc;
+    if (on_disk)
+        rc = (H5Tinsert(type, "t", 0, H5T_IEEE_F64LE) < 0 ||
+              H5Tinsert(type, "block", 8, H5T_STD_I32LE) < 0 ||
+              H5Tinsert(type, "from", 12, H5T_STD_I8LE) < 0 ||
+              H5Tinsert(type, "to", 13, H5T_STD_I8LE) < 0 ||
+              H5Tinsert(type, "x", 14, H5T_IEEE_F64LE) < 0 ||
+              H5Tinsert(type, "v", 22, H5T_IEEE_F64LE) < 0 ||
+              H5Tinsert(type, "force", 30, H5T_IEEE_F64LE) < 0)
+                 ? -1
+                 : 0;
+    else
+        rc = (H5Tinsert(type, "t", offsetof(bk_transition, t), H5T_NATIVE_DOUBLE) < 0 ||
+              H5Tinsert(type, "block", offsetof(bk_transition, block), H5T_NATIVE_INT32) < 0 ||
+              H5Tinsert(type, "from", offsetof(bk_transition, from), H5T_NATIVE_INT8) < 0 ||
+              H5Tinsert(type, "to", offsetof(bk_transition, to), H5T_NATIVE_INT8) < 0 ||
+              H5Tinsert(type, "x", offsetof(bk_transition, x), H5T_NATIVE_DOUBLE) < 0 ||
+              H5Tinsert(type, "v", offsetof(bk_transition, v), H5T_NATIVE_DOUBLE) < 0 ||
+              H5Tinsert(type, "force", offsetof(bk_transition, force), H5T_NATIVE_DOUBLE) < 0)
+                 ? -1
+                 : 0;
+    if (rc < 0) {
+        CLOSE_IDS(-1, type);
+        return H5I_INVALID_HID;
+    }
+    return type;
+}

@@ -1,0 +1,274 @@
+/* The integrity check behind `bksim info` and `bksim run --restart`: every dataset the
+ * writer created is there with the right shape, every value reads back (so every chunk's
+ * Fletcher32 checksum is checked) and makes sense, /transitions is ordered and valid, and the
+ * checkpoint verifies as a restart requires. */
+#include "bksim/inspect.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "output/h5_impl.h"
+
+/* What a check needs to know about the file as a whole. */
+typedef struct verify_ctx {
+    const char *path;
+    long long n_blocks;
+    double t_end, t_reached;
+    int complete;
+} verify_ctx;
+
+/* Rows read at a time while checking: whole chunks (a partial chunk would be read and its
+ * checksum computed once per piece), about EXPORT_BUDGET values. */
+static hsize_t scan_step(hid_t dset, hsize_t cols)
+{
+    hsize_t chunk = bk_h5_chunk_rows(dset);
+    if (chunk == 0)
+        chunk = 1;
+    hsize_t chunks = EXPORT_BUDGET / (chunk * (cols ? cols : 1));
+    return chunk * (chunks ? chunks : 1);
+}
+
+/* Every value of one time series, streamed a block of rows at a time: finite, modes and
+ * event flags from their sets, /time strictly increasing up to t_reached (and t_end when
+ * complete).  A chunk failing its checksum fails the read: damaged. */
+static int scan_series(hid_t file, const verify_ctx *v, const char *name, bk_error *err)
+{
+    const char *path = v->path;
+    hid_t dset;
+    hsize_t rows, cols;
+    int rank;
+    if (bk_h5_open_series(file, path, name, &dset, &rows, &cols, &rank, err) != BK_OK)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s cannot be read", path, name);
+    int is_time = strcmp(name, "time") == 0;
+    int is_mode = strcmp(name, "mode") == 0;
+    int is_event = strcmp(name, "event") == 0;
+    hsize_t step = scan_step(dset, cols);
+    if (step > rows)
+        step = rows ? rows : 1;
+    double *buf = malloc((size_t)(step * cols) * sizeof *buf);
+    int rc = buf ? BK_OK : BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    double prev = NAN, before = NAN; /* the value before this one; the block's last */
+    for (hsize_t start = 0; rc == BK_OK && start < rows; start += step) {
+        hsize_t count = rows - start < step ? rows - start : step;
+        if (bk_h5_read_block(dset, rank, start, count, 0, cols, H5T_NATIVE_DOUBLE, buf) < 0) {
+            rc = H5_DAMAGED(err, "%s: damaged: /%s rows %llu..%llu cannot be read", path, name,
+                            (unsigned long long)start, (unsigned long long)(start + count - 1));
+            break;
+        }
+        size_t values = (size_t)(count * cols);
+        for (size_t k = 0; rc == BK_OK && k < values; ++k) {
+            double x = buf[k];
+            int valid = is_mode    ? x == -1.0 || x == 0.0 || x == 1.0
+                        : is_event ? x == 0.0 || x == 1.0
+                                   : isfinite(x) && (!is_time || start + k == 0 || x > prev);
+            prev = x;
+            if (valid)
+                continue;
+            unsigned long long row = (unsigned long long)start + k / (size_t)cols;
+            unsigned long long col = k % (size_t)cols;
+            char where[64];
+            if (rank == 2)
+                snprintf(where, sizeof where, "row %llu column %llu", row, col);
+            else
+                snprintf(where, sizeof where, "row %llu", row);
+            if (is_mode)
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /mode %s is %g, not a mode "
+                             "(stick 0, slip+ 1, slip- -1)", path, where, x);
+            else if (is_event)
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /event %s is %g, not 0 or 1",
+                             path, where, x);
+            else if (!isfinite(x))
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s %s is %g, not finite", path,
+                             name, where, x);
+            else
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /time is not strictly increasing "
+                             "at row %llu (%.17g after %.17g)", path, row, x, k ? buf[k - 1] : before);
+        }
+        before = buf[values - 1];
+    }
+    free(buf);
+    bk_h5_close_id(dset);
+    if (rc != BK_OK || !is_time)
+        return rc;
+    if (rows > 0 && prev != v->t_reached)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: t_reached (%.17g) is not the last time "
+                       "(%.17g)", path, v->t_reached, prev);
+    if (v->complete && (rows == 0 || fabs(prev - v->t_end) > 1e-9 * fabs(v->t_end)))
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: marked complete but /time ends at %.17g, "
+                       "not t_end = %.17g", path, rows ? prev : NAN, v->t_end);
+    return BK_OK;
+}
+
+static int valid_mode(int8_t mode)
+{
+    return mode == -1 || mode == 0 || mode == 1;
+}
+
+/* /transitions in time order, each of an existing block, between modes, at a time the run
+ * reached, with finite values.  The bound is t_reached for a complete run; an unfinished
+ * run may have flushed transitions after its last row (with event_rows off there is no row
+ * at a transition), so there it is t_end. */
+/* Restate the error just recorded as damage to path; its message is copied first, since
+ * BK_FAIL formats into the same buffer. */
+static int mark_damaged(bk_error *err, const char *path, const char *fallback)
+{
+    char reason[BK_ERROR_MESSAGE_LEN];
+    snprintf(reason, sizeof reason, "%s", err && err->message[0] ? err->message : fallback);
+    return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: %s", path, reason);
+}
+
+static int scan_transitions(hid_t file, const verify_ctx *v, bk_error *err)
+{
+    const char *path = v->path;
+    hid_t dset, mem;
+    hsize_t count;
+    if (bk_h5_open_transitions(file, path, &dset, &mem, &count, err) != BK_OK)
+        return mark_damaged(err, path, "/transitions cannot be read");
+    double bound = v->complete ? v->t_reached : v->t_end;
+    bound += 1e-9 * fabs(bound);
+    bk_transition *buf = malloc(TRANSITION_BUFFER * sizeof *buf);
+    int rc = buf ? BK_OK : BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    double prev = 0.0;
+    for (hsize_t start = 0; rc == BK_OK && start < count; start += TRANSITION_BUFFER) {
+        size_t n = count - start < TRANSITION_BUFFER ? (size_t)(count - start) : TRANSITION_BUFFER;
+        if (bk_h5_read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
+            rc = H5_DAMAGED(err, "%s: damaged: /transitions rows %llu..%llu cannot be read", path,
+                            (unsigned long long)start, (unsigned long long)(start + n - 1));
+            break;
+        }
+        for (size_t k = 0; rc == BK_OK && k < n; ++k) {
+            const bk_transition *t = &buf[k];
+            unsigned long long row = (unsigned long long)(start + k);
+            if (!isfinite(t->t) || !isfinite(t->x) || !isfinite(t->v) || !isfinite(t->force))
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu has a value "
+                             "that is not finite (t %g, x %g, v %g, force %g)", path, row, t->t,
+                             t->x, t->v, t->force);
+            else if (t->t < prev)
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions is not in time order "
+                             "at row %llu (t = %.17g s after %.17g s)", path, row, t->t, prev);
+            else if (t->t > bound)
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu is at "
+                             "t = %.17g s, after the %s (%.17g s)", path, row, t->t,
+                             v->complete ? "end of the run" : "run's t_end",
+                             v->complete ? v->t_reached : v->t_end);
+            else if (t->block < 0 || t->block >= v->n_blocks)
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu names block "
+                             "%d, outside 0..%lld", path, row, (int)t->block, v->n_blocks - 1);
+            else if (!valid_mode(t->from) || !valid_mode(t->to))
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu goes from "
+                             "mode %d to %d; modes are stick 0, slip+ 1, slip- -1", path, row,
+                             (int)t->from, (int)t->to);
+            prev = t->t;
+        }
+    }
+    free(buf);
+    CLOSE_IDS(0, mem, dset);
+    return rc;
+}
+
+/* The datasets a file must hold: those its writer recorded, or for a file written before
+ * that record, those its stored config selects (time, driver, event if it does not load).
+ * Malloc'ed, comma-separated; NULL when out of memory. */
+static char *expected_datasets(hid_t file)
+{
+    char *names = bk_h5_recorded_datasets(file);
+    if (names)
+        return names;
+    bk_config *config = NULL;
+    bk_error ignored;
+    char list[BK_DATASET_LIST_LEN] = "time,driver,event";
+    if (bk_h5_load_stored_config(file, "", &config, &ignored) == BK_OK)
+        bk_output_dataset_names(config->output.fields, config->model->n_friction_state,
+                     config->output.transitions, list, sizeof list);
+    bk_config_free(config);
+    return strdup(list);
+}
+
+/* The integrity check on an open file (see bk_h5_verify). */
+int bk_h5_verify_open(hid_t file, const char *path, bk_error *err)
+{
+    verify_ctx v = {path, 0, NAN, NAN, 0};
+    if (bk_h5_read_numeric_attr(file, "complete", H5T_NATIVE_INT, &v.complete) < 0 ||
+        bk_h5_read_numeric_attr(file, "n_blocks", H5T_NATIVE_LLONG, &v.n_blocks) < 0 ||
+        bk_h5_read_numeric_attr(file, "t_end", H5T_NATIVE_DOUBLE, &v.t_end) < 0 ||
+        bk_h5_read_numeric_attr(file, "t_reached", H5T_NATIVE_DOUBLE, &v.t_reached) < 0)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: a root attribute (complete, n_blocks, t_end, "
+                       "t_reached) is missing", path);
+    if (v.n_blocks < 1 || !isfinite(v.t_end) || !(v.t_end > 0.0))
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: root attributes n_blocks = %lld, t_end = %g "
+                       "are not a run's", path, v.n_blocks, v.t_end);
+    int rc = bk_h5_require_datasets(file, path, "time,driver,event", err);
+    if (rc != BK_OK)
+        return rc;
+    char *expected = expected_datasets(file);
+    if (!expected)
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    rc = bk_h5_require_datasets(file, path, expected, err);
+    free(expected);
+    if (rc != BK_OK)
+        return rc;
+    hid_t time;
+    hsize_t rows, cols;
+    int rank;
+    rc = bk_h5_open_series(file, path, "time", &time, &rows, &cols, &rank, err);
+    if (rc != BK_OK)
+        return mark_damaged(err, path, "/time");
+    bk_h5_close_id(time);
+    if (rank != 1)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /time has rank %d, not 1", path, rank);
+    bk_h5_name_list list;
+    if (bk_h5_list_series(file, &list) != 0)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: cannot list the datasets", path);
+    /* Shapes first: a short series is named as such rather than as a read error. */
+    for (size_t k = 0; rc == BK_OK && k < list.count; ++k) {
+        hid_t d;
+        hsize_t r, c;
+        int rk;
+        if (bk_h5_open_series(file, path, list.names[k], &d, &r, &c, &rk, err) != BK_OK) {
+            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s cannot be read", path, list.names[k]);
+            continue;
+        }
+        bk_h5_close_id(d);
+        int per_block = rk == 2 && strcmp(list.names[k], "friction_state") != 0;
+        if (r != rows)
+            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s has %llu rows, /time has %llu", path,
+                         list.names[k], (unsigned long long)r, (unsigned long long)rows);
+        else if (per_block && (long long)c != v.n_blocks)
+            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s has %llu columns for %lld blocks", path,
+                         list.names[k], (unsigned long long)c, v.n_blocks);
+    }
+    /* /time before the others, so that its own faults are named first. */
+    if (rc == BK_OK)
+        rc = scan_series(file, &v, "time", err);
+    for (size_t k = 0; rc == BK_OK && k < list.count; ++k)
+        if (strcmp(list.names[k], "time") != 0)
+            rc = scan_series(file, &v, list.names[k], err);
+    bk_h5_name_list_free(&list);
+    if (rc == BK_OK && H5Lexists(file, "transitions", H5P_DEFAULT) > 0)
+        rc = scan_transitions(file, &v, err);
+    if (rc == BK_OK && H5Lexists(file, "checkpoint", H5P_DEFAULT) > 0) {
+        bk_h5_slot slot;
+        bk_error why = {0};
+        int found = bk_h5_find_checkpoint(file, path, (size_t)v.n_blocks, &slot, &why);
+        if (found == BK_OK)
+            bk_checkpoint_free(&slot.checkpoint);
+        else if (!slot.legacy && found != BK_ERR_INVALID) /* no damage: an older bksim's checkpoint
+                                                        cannot be verified; a first one torn */
+            rc = BK_FAIL(err, found, "%s", why.message);
+    }
+    if (rc != BK_OK)
+        return rc;
+    return v.complete ? BK_OK : BK_INCOMPLETE;
+}
+
+int bk_h5_verify(const char *path, bk_error *err)
+{
+    hid_t file;
+    int rc = bk_h5_open_input(path, &file, err);
+    if (rc != BK_OK)
+        return rc;
+    rc = bk_h5_verify_open(file, path, err);
+    bk_h5_close_id(file);
+    return rc;
+}

@@ -1,0 +1,535 @@
+/* The streaming writer: a bk_sink that buffers a chunk's worth of rows and appends them to
+ * extendable datasets of "<path>.part", renamed to <path> once the run is complete.  The
+ * datasets come from the layout table (layout.h); checkpoint slots are written by
+ * h5_checkpoint.c, which also reopens a stopped run's file to continue it. */
+#include "bksim/output.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "bksim/bksim.h"
+#include "output/h5_impl.h"
+#include "output/paths.h"
+
+/* Shuffle + deflate at this level; 0 writes unfiltered chunks.  Off because it costs more
+ * than it saves when output is dense: on stick-slip-like data level 1 shrank files to
+ * ~0.35 of raw but cut write throughput from ~300-600 MB/s to ~40-95 MB/s (about 3.5 us
+ * per row at N = 3 with 512-row chunks, 30 us per row at N = 100), the same order as the
+ * integration itself.  `h5repack -f SHUF -f GZIP=1` compresses a finished file. */
+#define DEFLATE_LEVEL 0u
+
+static hid_t create_extendable(hid_t file, const char *name, hid_t type, int rank,
+                               hsize_t cols, hsize_t chunk_rows)
+{
+    hsize_t dims[2] = {0, cols};
+    hsize_t max_dims[2] = {H5S_UNLIMITED, cols};
+    hsize_t chunk[2] = {chunk_rows, cols};
+    hid_t space = H5I_INVALID_HID, dcpl = H5I_INVALID_HID, dset = H5I_INVALID_HID;
+    space = H5Screate_simple(rank, dims, max_dims);
+    dcpl = H5Pcreate(H5P_DATASET_CREATE);
+    if (space < 0 || dcpl < 0 || H5Pset_chunk(dcpl, rank, chunk) < 0)
+        goto done;
+    if (DEFLATE_LEVEL > 0 && H5Zfilter_avail(H5Z_FILTER_DEFLATE) > 0 &&
+        (H5Pset_shuffle(dcpl) < 0 || H5Pset_deflate(dcpl, DEFLATE_LEVEL) < 0))
+        goto done;
+    /* A checksum per chunk: bytes damaged on disk make the read fail instead of returning
+     * plausible numbers, and `bksim info` reads every chunk. */
+    if (H5Pset_fletcher32(dcpl) < 0)
+        goto done;
+    dset = H5Dcreate2(file, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+done:
+    CLOSE_IDS(dset, dcpl, space);
+    return dset;
+}
+
+/* Which block each friction-state column belongs to (-1 when no block claims it). */
+static herr_t write_state_blocks(hid_t dset, const bk_model *model)
+{
+    size_t n_state = model->n_friction_state;
+    int32_t *blocks = malloc(n_state * sizeof *blocks);
+    if (!blocks)
+        return -1;
+    for (size_t c = 0; c < n_state; ++c)
+        blocks[c] = -1;
+    for (size_t i = 0; i < model->n_blocks; ++i) {
+        const bk_block *b = &model->blocks[i];
+        size_t n = b->law ? b->law->n_state : 0;
+        for (size_t k = 0; k < n && b->state_offset + k < n_state; ++k)
+            blocks[b->state_offset + k] = (int32_t)i;
+    }
+    hsize_t dims[1] = {n_state};
+    hid_t space = H5Screate_simple(1, dims, NULL);
+    hid_t attr = space < 0 ? H5I_INVALID_HID
+                           : H5Acreate2(dset, "block", H5T_STD_I32LE, space, H5P_DEFAULT,
+                                        H5P_DEFAULT);
+    herr_t rc = attr < 0 ? -1 : H5Awrite(attr, H5T_NATIVE_INT32, blocks);
+    CLOSE_IDS(rc, attr, space);
+    free(blocks);
+    return rc;
+}
+
+static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err)
+{
+    const bk_model *model = config->model;
+    size_t n_state = model->n_friction_state;
+    unsigned fields = config->output.fields;
+    hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
+    /* Tracking link creation order lets readers list datasets in the order written here. */
+    if (fcpl < 0 ||
+        H5Pset_link_creation_order(fcpl, H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED) < 0) {
+        int rc = H5_FAIL(err, "%s: cannot set up file creation properties", w->part);
+        CLOSE_IDS(-1, fcpl);
+        return rc;
+    }
+    w->file = H5Fcreate(w->part, H5F_ACC_TRUNC, fcpl, H5P_DEFAULT);
+    if (w->file < 0) {
+        int rc = H5_FAIL(err, "%s: cannot create file", w->part);
+        CLOSE_IDS(-1, fcpl);
+        return rc;
+    }
+    CLOSE_IDS(0, fcpl);
+
+    if (bk_h5_write_string_attr(w->file, "config", config->text) < 0 ||
+        bk_h5_write_string_attr(w->file, "config_name", config->source_name) < 0 ||
+        bk_h5_write_string_attr(w->file, "version", BKSIM_VERSION) < 0 ||
+        bk_h5_write_long_attr(w->file, "n_blocks", (long long)model->n_blocks) < 0 ||
+        bk_h5_write_double_attr(w->file, "t_end", config->t_end) < 0 ||
+        bk_h5_write_int_attr(w->file, "complete", 0) < 0 ||
+        bk_h5_write_double_attr(w->file, "t_reached", 0.0) < 0 ||
+        bk_h5_write_string_attr(w->file, "attribute_units", "t_end: s, t_reached: s") < 0)
+        return H5_FAIL(err, "%s: cannot write root attributes", w->part);
+    /* What a restart needs to load the same config again: the file as read and the --set
+     * overrides (the `config` attribute shows them only as comments). */
+    size_t len = 1;
+    for (size_t k = 0; k < config->n_overrides; ++k)
+        len += strlen(config->overrides[k]) + 1;
+    char *overrides = calloc(len, 1);
+    if (!overrides)
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", w->part);
+    for (size_t k = 0; k < config->n_overrides; ++k) {
+        strcat(overrides, config->overrides[k]);
+        strcat(overrides, "\n");
+    }
+    herr_t stored = bk_h5_write_string_attr(w->file, "config_file", config->file_text ? config->file_text : config->text);
+    if (stored >= 0)
+        stored = bk_h5_write_string_attr(w->file, "overrides", overrides);
+    free(overrides);
+    char names[BK_DATASET_LIST_LEN];
+    bk_output_dataset_names(fields, n_state, config->output.transitions, names, sizeof names);
+    if (stored >= 0)
+        stored = bk_h5_write_string_attr(w->file, "datasets", names);
+    if (stored < 0)
+        return H5_FAIL(err, "%s: cannot write root attributes", w->part);
+
+    bk_h5_writer_size(w, model);
+    for (int i = 0; i < BK_N_SERIES; ++i) {
+        const bk_series_def *def = &bk_series[i];
+        bk_h5_series *s = &w->s[i];
+        if (!bk_series_selected(def, fields, n_state))
+            continue;
+        if (bk_h5_writer_series(w, i, model) < 0)
+            return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for the /%s buffer", w->part,
+                           def->name);
+        hsize_t chunk_rows = s->rank == 1 ? SERIES_1D_CHUNK : (hsize_t)w->buffer_rows;
+        s->dset = create_extendable(w->file, def->name, bk_h5_kind_file_type(def->kind), s->rank,
+                                    (hsize_t)s->cols, chunk_rows);
+        if (s->dset < 0)
+            return H5_FAIL(err, "%s: cannot create dataset /%s", w->part, def->name);
+        if (bk_h5_describe(s->dset, def->units, def->description) < 0)
+            return H5_FAIL(err, "%s: cannot write attributes of /%s", w->part, def->name);
+        if (i == BK_SERIES_STATE && write_state_blocks(s->dset, model) < 0)
+            return H5_FAIL(err, "%s: cannot write attribute /friction_state/block", w->part);
+    }
+
+    if (config->output.transitions) {
+        if (bk_h5_writer_transition_buffer(w) < 0 && !w->trans_buf)
+            return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for the transition buffer",
+                           w->part);
+        hid_t disk = bk_h5_transition_type(1);
+        if (w->trans_mem >= 0 && disk >= 0)
+            w->trans_dset = create_extendable(w->file, "transitions", disk, 1, 1,
+                                              TRANSITION_BUFFER);
+        CLOSE_IDS(w->trans_dset, disk);
+        if (w->trans_dset < 0)
+            return H5_FAIL(err, "%s: cannot create dataset /transitions", w->part);
+        if (bk_h5_describe(w->trans_dset, BK_TRANSITIONS_UNITS, BK_TRANSITIONS_DESCRIPTION) < 0)
+            return H5_FAIL(err, "%s: cannot write attributes of /transitions", w->part);
+    }
+    /* The variable-length strings above go to disk now, once: nothing rewrites them later
+     * (see bk_h5_write_fixed_string_attr). */
+    if (H5Fflush(w->file, H5F_SCOPE_LOCAL) < 0)
+        return H5_FAIL(err, "%s: cannot flush", w->part);
+    return BK_OK;
+}
+
+/* Close every id the writer holds; -1 if any close failed.
+ *
+ * The file id goes first, while the datasets still hold the file open, so that H5Fclose
+ * only drops the id and the real close (the final flush) happens in the last H5Dclose.
+ * HDF5 1.10 keeps a file id whose close failed (disk full) pointing at freed memory and
+ * crashes when H5close() tries it again at exit; H5Dclose always releases its id.  Write
+ * errors are caught before this by an explicit H5Fflush. */
+herr_t bk_h5_writer_close(bk_h5_writer *w)
+{
+    herr_t rc = 0;
+    if (w->file >= 0 && H5Fclose(w->file) < 0)
+        rc = -1;
+    for (int i = 0; i < BK_N_SERIES; ++i) {
+        if (w->s[i].dset >= 0 && H5Dclose(w->s[i].dset) < 0)
+            rc = -1;
+        w->s[i].dset = H5I_INVALID_HID;
+    }
+    if (w->trans_dset >= 0 && H5Dclose(w->trans_dset) < 0)
+        rc = -1;
+    if (w->trans_mem >= 0 && H5Tclose(w->trans_mem) < 0)
+        rc = -1;
+    w->trans_dset = w->trans_mem = w->file = H5I_INVALID_HID;
+    return rc;
+}
+
+void bk_h5_writer_free(bk_h5_writer *w)
+{
+    for (int i = 0; i < BK_N_SERIES; ++i)
+        free(w->s[i].buf);
+    free(w->trans_buf);
+    free(w->path);
+    free(w->part);
+    free(w);
+}
+
+int bk_h5_writer_new(bk_h5_writer **out, const char *path, bk_error *err)
+{
+    *out = NULL;
+    bk_h5_writer *w = calloc(1, sizeof *w);
+    if (!w)
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    w->file = w->trans_dset = w->trans_mem = H5I_INVALID_HID;
+    for (int i = 0; i < BK_N_SERIES; ++i)
+        w->s[i].dset = H5I_INVALID_HID;
+    w->path = strdup(path);
+    w->part = bk_output_part_path(path);
+    if (!w->path || !w->part) {
+        bk_h5_writer_free(w);
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    }
+    *out = w;
+    return BK_OK;
+}
+
+void bk_h5_writer_size(bk_h5_writer *w, const bk_model *model)
+{
+    size_t n_state = model->n_friction_state;
+    size_t widest = model->n_blocks > n_state ? model->n_blocks : n_state;
+    size_t rows = CHUNK_BYTES / (widest * sizeof(double));
+    w->n_blocks = model->n_blocks;
+    w->buffer_rows = rows < 1 ? 1 : rows > MAX_BUFFER_ROWS ? MAX_BUFFER_ROWS : rows;
+}
+
+int bk_h5_writer_series(bk_h5_writer *w, int i, const bk_model *model)
+{
+    const bk_series_def *def = &bk_series[i];
+    bk_h5_series *s = &w->s[i];
+    s->rank = def->shape == BK_SHAPE_T ? 1 : 2;
+    s->cols = bk_series_columns(def, model->n_blocks, model->n_friction_state);
+    s->elem = bk_series_value_size(def->kind);
+    s->buf = malloc(w->buffer_rows * s->cols * s->elem);
+    return s->buf ? 0 : -1;
+}
+
+int bk_h5_writer_transition_buffer(bk_h5_writer *w)
+{
+    w->trans_buf = malloc(TRANSITION_BUFFER * sizeof *w->trans_buf);
+    w->trans_mem = w->trans_buf ? bk_h5_transition_type(0) : H5I_INVALID_HID;
+    return w->trans_buf && w->trans_mem >= 0 ? 0 : -1;
+}
+
+int bk_h5_writer_open(bk_h5_writer **out, const bk_config *config, const char *path,
+                      bk_error *err)
+{
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    if (out)
+        *out = NULL;
+    if (!out || !config || !config->model || config->model->n_blocks == 0 || !path || !*path)
+        return BK_FAIL(err, BK_ERR_INVALID,
+                       "bk_h5_writer_open: needs a writer pointer, a config with a model and "
+                       "an output path");
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        return BK_FAIL(err, BK_ERR_IO, "%s: is a directory; give an output file name", path);
+
+    bk_h5_writer *w;
+    int rc = bk_h5_writer_new(&w, path, err);
+    if (rc != BK_OK)
+        return rc;
+    rc = bk_output_make_parent_dirs(path, err);
+    if (rc != BK_OK) {
+        bk_h5_writer_free(w);
+        return rc;
+    }
+    rc = create_layout(w, config, err);
+    if (rc != BK_OK) {
+        int created = w->file >= 0;
+        bk_h5_writer_close(w);
+        if (created)
+            remove(w->part);
+        bk_h5_writer_free(w);
+        return rc;
+    }
+    *out = w;
+    return BK_OK;
+}
+
+/* Extend dset by count rows and write them from buf. */
+static herr_t append(hid_t dset, int rank, hsize_t start, hsize_t count, hsize_t cols,
+                     hid_t mem_type, const void *buf)
+{
+    hsize_t dims[2] = {start + count, cols};
+    hsize_t offset[2] = {start, 0};
+    hsize_t counts[2] = {count, cols};
+    hid_t file_space = H5I_INVALID_HID, mem_space = H5I_INVALID_HID;
+    herr_t rc = -1;
+    if (H5Dset_extent(dset, dims) < 0)
+        goto done;
+    file_space = H5Dget_space(dset);
+    if (file_space < 0 ||
+        H5Sselect_hyperslab(file_space, H5S_SELECT_SET, offset, NULL, counts, NULL) < 0)
+        goto done;
+    mem_space = H5Screate_simple(rank, counts, NULL);
+    if (mem_space < 0)
+        goto done;
+    rc = H5Dwrite(dset, mem_type, mem_space, file_space, H5P_DEFAULT, buf);
+done:
+    CLOSE_IDS(rc, mem_space, file_space);
+    return rc;
+}
+
+static int flush_transitions(bk_h5_writer *w, bk_error *err)
+{
+    if (w->trans_buffered == 0)
+        return BK_OK;
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    if (append(w->trans_dset, 1, w->trans_written, (hsize_t)w->trans_buffered, 1, w->trans_mem,
+               w->trans_buf) < 0) {
+        w->failed = 1;
+        return H5_FAIL(err, "%s: cannot append to /transitions", w->part);
+    }
+    w->trans_written += w->trans_buffered;
+    w->trans_last_t = w->trans_buf[w->trans_buffered - 1].t;
+    w->trans_buffered = 0;
+    return BK_OK;
+}
+
+/* Write buffered rows and transitions, then flush HDF5's metadata so that a run killed
+ * later still leaves a readable .part holding everything up to here. */
+int bk_h5_writer_flush(bk_h5_writer *w, bk_error *err)
+{
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    if (w->buffered > 0) {
+        for (int i = 0; i < BK_N_SERIES; ++i) {
+            bk_h5_series *s = &w->s[i];
+            if (s->dset < 0)
+                continue;
+            if (append(s->dset, s->rank, w->rows_written, (hsize_t)w->buffered,
+                       (hsize_t)s->cols, bk_h5_kind_mem_type(bk_series[i].kind), s->buf) < 0) {
+                w->failed = 1;
+                return H5_FAIL(err, "%s: cannot append rows to /%s", w->part, bk_series[i].name);
+            }
+        }
+        w->rows_written += w->buffered;
+        w->buffered = 0;
+        w->t_written = w->t_buffered;
+    }
+    int rc = flush_transitions(w, err);
+    if (rc != BK_OK)
+        return rc;
+    if (bk_h5_write_double_attr(w->file, "t_reached", w->t_written) < 0 ||
+        H5Fflush(w->file, H5F_SCOPE_LOCAL) < 0) {
+        w->failed = 1;
+        return H5_FAIL(err, "%s: cannot flush", w->part);
+    }
+    return BK_OK;
+}
+
+static void put(bk_h5_series *s, size_t row, const void *values)
+{
+    if (s->dset >= 0)
+        memcpy(s->buf + row * s->cols * s->elem, values, s->cols * s->elem);
+}
+
+static int sink_sample(void *self, const bk_sample *sample, bk_error *err)
+{
+    bk_h5_writer *w = self;
+    if (w->failed)
+        return BK_FAIL(err, BK_ERR_HDF5, "%s: an earlier write failed; no more rows accepted",
+                       w->part);
+    if (sample->n_blocks != w->n_blocks)
+        return BK_FAIL(err, BK_ERR_INVALID, "%s: sample has %zu blocks, the file %zu",
+                       w->part, sample->n_blocks, w->n_blocks);
+    const void *arrays[BK_N_SERIES] = {
+        [BK_SERIES_X] = sample->x,
+        [BK_SERIES_V] = sample->v,
+        [BK_SERIES_FRICTION] = sample->friction,
+        [BK_SERIES_COF] = sample->cof,
+        [BK_SERIES_MODE] = sample->mode,
+        [BK_SERIES_STATE] = sample->friction_state,
+    };
+    /* Check before copying anything so a rejected sample leaves no partial row. */
+    for (int i = 0; i < BK_N_SERIES; ++i)
+        if (bk_series[i].shape != BK_SHAPE_T && w->s[i].dset >= 0 && !arrays[i])
+            return BK_FAIL(err, BK_ERR_INVALID, "%s: sample lacks the values of /%s",
+                           w->part, bk_series[i].name);
+    size_t row = w->buffered;
+    uint8_t event = sample->is_event ? 1 : 0;
+    put(&w->s[BK_SERIES_TIME], row, &sample->t);
+    put(&w->s[BK_SERIES_DRIVER], row, &sample->driver);
+    put(&w->s[BK_SERIES_EVENT], row, &event);
+    put(&w->s[BK_SERIES_EKIN], row, &sample->kinetic_energy);
+    put(&w->s[BK_SERIES_EEL], row, &sample->elastic_energy);
+    put(&w->s[BK_SERIES_WORK], row, &sample->work_driver);
+    put(&w->s[BK_SERIES_DISS], row, &sample->dissipation);
+    for (int i = 0; i < BK_N_SERIES; ++i)
+        if (bk_series[i].shape != BK_SHAPE_T)
+            put(&w->s[i], row, arrays[i]);
+    w->buffered = row + 1;
+    w->t_buffered = sample->t;
+    return w->buffered == w->buffer_rows ? bk_h5_writer_flush(w, err) : BK_OK;
+}
+
+static int sink_transition(void *self, const bk_transition *transition, bk_error *err)
+{
+    bk_h5_writer *w = self;
+    if (w->failed)
+        return BK_FAIL(err, BK_ERR_HDF5,
+                       "%s: an earlier write failed; no more transitions accepted", w->part);
+    if (transition->block < 0 || (size_t)transition->block >= w->n_blocks)
+        return BK_FAIL(err, BK_ERR_INVALID, "%s: transition of block %d, allowed 0..%zu",
+                       w->part, (int)transition->block, w->n_blocks - 1);
+    if (w->trans_dset < 0)
+        return BK_OK;
+    w->trans_buf[w->trans_buffered++] = *transition;
+    return w->trans_buffered == TRANSITION_BUFFER ? flush_transitions(w, err) : BK_OK;
+}
+
+bk_sink bk_h5_writer_sink(bk_h5_writer *writer)
+{
+    bk_sink sink = {writer, sink_sample, sink_transition, bk_h5_sink_checkpoint};
+    return sink;
+}
+
+herr_t bk_h5_write_stats(hid_t file, const bk_run_stats *stats)
+{
+    hid_t gcpl = H5I_INVALID_HID, group = H5I_INVALID_HID;
+    herr_t rc = -1;
+    htri_t exists = H5Lexists(file, "stats", H5P_DEFAULT);
+    if (exists < 0)
+        goto done;
+    if (exists) {
+        group = H5Gopen2(file, "stats", H5P_DEFAULT);
+    } else {
+        /* Creation order lets `bksim info` list the statistics in this table's order. */
+        gcpl = H5Pcreate(H5P_GROUP_CREATE);
+        if (gcpl < 0 ||
+            H5Pset_attr_creation_order(gcpl, H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED) < 0)
+            goto done;
+        group = H5Gcreate2(file, "stats", H5P_DEFAULT, gcpl, H5P_DEFAULT);
+    }
+    if (group < 0)
+        goto done;
+    char method[sizeof stats->method + 1];
+    memcpy(method, stats->method, sizeof stats->method);
+    method[sizeof stats->method] = '\0';
+    if (bk_h5_write_fixed_string_attr(group, "method", method) < 0)
+        goto done;
+    char units[1024] = "";
+    size_t used = 0;
+    for (size_t i = 0; i < bk_run_stats_n_fields; ++i) {
+        const char *field = (const char *)stats + bk_run_stats_fields[i].offset;
+        herr_t ok;
+        if (bk_run_stats_fields[i].is_long) {
+            long value;
+            memcpy(&value, field, sizeof value);
+            ok = bk_h5_write_long_attr(group, bk_run_stats_fields[i].name, value);
+        } else {
+            double value;
+            memcpy(&value, field, sizeof value);
+            ok = bk_h5_write_double_attr(group, bk_run_stats_fields[i].name, value);
+        }
+        if (ok < 0)
+            goto done;
+        int n = snprintf(units + used, sizeof units - used, "%s%s: %s", i ? ", " : "",
+                         bk_run_stats_fields[i].name, bk_run_stats_fields[i].units);
+        if (n > 0 && (size_t)n < sizeof units - used)
+            used += (size_t)n;
+    }
+    rc = bk_h5_describe_fixed(group, units, "solver statistics of the run");
+done:
+    CLOSE_IDS(rc, group, gcpl);
+    return rc;
+}
+
+/* After a failure that followed complete = 1: take the mark back, so a .part never claims
+ * to be complete.  Best effort: the file may be what failed.  /time is held open across
+ * H5Fclose for the reason given at close_writer. */
+static void mark_incomplete(const char *part, const char *reason)
+{
+    hid_t file = H5Fopen(part, H5F_ACC_RDWR, H5P_DEFAULT);
+    if (file < 0)
+        return;
+    hid_t hold = H5Dopen2(file, "time", H5P_DEFAULT);
+    bk_h5_write_int_attr(file, "complete", 0);
+    bk_h5_write_fixed_string_attr(file, "error", reason);
+    H5Fclose(file);
+    if (hold >= 0)
+        H5Dclose(hold);
+}
+
+int bk_h5_writer_finish(bk_h5_writer *writer, const bk_run_stats *stats, bk_error *err)
+{
+    bk_h5_writer *w = writer;
+    if (!w)
+        return BK_FAIL(err, BK_ERR_INVALID, "bk_h5_writer_finish: no writer");
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    int rc = BK_OK;
+    int marked = 0;
+    if (w->failed)
+        rc = BK_FAIL(err, BK_ERR_HDF5, "%s: not completed: an earlier write failed", w->part);
+    if (rc == BK_OK)
+        rc = bk_h5_writer_flush(w, err);
+    if (rc == BK_OK && stats && bk_h5_write_stats(w->file, stats) < 0)
+        rc = H5_FAIL(err, "%s: cannot write /stats", w->part);
+    if (rc == BK_OK) {
+        marked = 1;
+        /* Flushed here rather than at close, where a failure could not be told apart. */
+        if (bk_h5_write_int_attr(w->file, "complete", 1) < 0 ||
+            H5Fflush(w->file, H5F_SCOPE_LOCAL) < 0)
+            rc = H5_FAIL(err, "%s: cannot write the complete flag", w->part);
+    }
+    if (bk_h5_writer_close(w) < 0 && rc == BK_OK)
+        rc = H5_FAIL(err, "%s: cannot close", w->part);
+    if (rc == BK_OK)
+        rc = bk_output_durable_rename(w->part, w->path, err);
+    if (rc != BK_OK && marked)
+        mark_incomplete(w->part, err ? err->message : "finishing the output failed");
+    bk_h5_writer_free(w);
+    return rc;
+}
+
+void bk_h5_writer_abandon(bk_h5_writer *writer, const char *reason, const bk_run_stats *stats)
+{
+    bk_h5_writer *w = writer;
+    if (!w)
+        return;
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    bk_error ignored;
+    /* After a failed append the datasets may be ragged; appending again would misalign. */
+    if (!w->failed)
+        bk_h5_writer_flush(w, &ignored);
+    if (stats)
+        bk_h5_write_stats(w->file, stats);
+    bk_h5_write_int_attr(w->file, "complete", 0);
+    bk_h5_write_double_attr(w->file, "t_reached", w->t_written);
+    bk_h5_write_fixed_string_attr(w->file, "error", reason ? reason : "run abandoned");
+    bk_h5_writer_close(w);
+    bk_h5_writer_free(w);
+}

@@ -1,0 +1,12 @@
+/* File-system helpers of the writer (paths.c); the .part naming is public (output.h). */
+#ifndef BKSIM_OUTPUT_PATHS_H
+#define BKSIM_OUTPUT_PATHS_H
+
+#include "bksim/status.h"
+
+/* mkdir -p for the directory part of path. */
+int bk_output_make_parent_dirs(const char *path, bk_error *err);
+/* Sync part to disk, rename it to path, and sync the directory (best effort). */
+int bk_output_durable_rename(const char *part, const char *path, bk_error *err);
+
+#endif
