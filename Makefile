@@ -72,9 +72,13 @@ test-valgrind: bksim $(TESTS)
 	@BK_TEST_TIME_SCALE=200 VALGRIND="valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible --show-leak-kinds=definite,indirect,possible" \
 	 scripts/run_tests.sh valgrind $(TESTS)
 
-# Static analysis; options and suppressions are committed in tests/cppcheck.cfg.
-lint:
+# Static analysis (options and suppressions in tests/cppcheck.cfg), then the library's
+# namespace: every symbol libbksim.a exports starts with bk_.
+lint: build/libbksim.a
 	cppcheck $$(cat tests/cppcheck.cfg) -Iinclude -Isrc src tests/*.c tests/fuzz/*.c bench/*.c
+	@bad=$$(nm -g --defined-only build/libbksim.a | awk 'NF == 3 && $$3 !~ /^bk_/ {print $$3}'); \
+	 if [ -n "$$bad" ]; then echo "lint: symbols of libbksim.a without the bk_ prefix:" $$bad >&2; exit 1; fi; \
+	 echo "lint: every exported symbol of libbksim.a starts with bk_"
 
 paper: bksim
 	scripts/run_paper.sh
