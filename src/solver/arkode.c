@@ -20,6 +20,7 @@
  * giving both halves) plus those ARKODE makes for difference-quotient Jacobians
  * (ARKStepGetNumLinRhsEvals). */
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,17 +28,10 @@
 
 #include <arkode/arkode_arkstep.h>
 #include <nvector/nvector_serial.h>
-#include <sundials/sundials_context.h>
-#include <sunlinsol/sunlinsol_band.h>
-#include <sunlinsol/sunlinsol_dense.h>
-#include <sunmatrix/sunmatrix_band.h>
-#include <sunmatrix/sunmatrix_dense.h>
 
 #include "bksim/solver.h"
+#include "sundials_common.h"
 #include "sundials_jacobian.h"
-
-/* Above this size "auto" picks the band solver (when the layout is banded); as cvode.c. */
-#define BAND_THRESHOLD 16
 
 typedef enum { KIND_EXPLICIT, KIND_IMPLICIT, KIND_IMEX } ark_kind;
 
@@ -132,49 +126,32 @@ static int check_dirk(const bk_solver_options *options, char *message, size_t le
 }
 
 typedef struct arkode_backend {
+    bk_sundials_base base;        /* first: the state is its base (sundials_common.h) */
     ark_variant variant;
-    bk_solver_options options;
-    SUNContext ctx;
     void *arkode;
-    N_Vector y, atol, work;
-    SUNMatrix matrix;
-    SUNLinearSolver linear_solver;
-    size_t n;                     /* size the ARKODE objects were built for */
-    int n_roots;                  /* size RootInit was called with */
-    bk_ode_problem problem;
     int split;                    /* arkode_imex on a problem with rhs_split */
     double *cache_y, *cache_fe, *cache_fi; /* split: the last rhs_split, at (cache_t, cache_y) */
     double cache_t;
     int cache_valid;
     long split_evals;             /* rhs_split calls in the current start */
-    double t_stop;
-    bk_solver_counters done;      /* counters of finished starts */
-    char message[512];            /* last message from ARKODE's error handler */
 } arkode_backend;
-
-static void capture_message(int error_code, const char *module, const char *function,
-                            char *msg, void *user)
-{
-    arkode_backend *ark = user;
-    snprintf(ark->message, sizeof ark->message, "%s (%s, code %d)", msg,
-             function ? function : module, error_code);
-}
+_Static_assert(offsetof(arkode_backend, base) == 0, "the state is allocated and freed through its base");
 
 static int rhs_adapter(sunrealtype t, N_Vector y, N_Vector ydot, void *user)
 {
     arkode_backend *ark = user;
-    return ark->problem.rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot), ark->problem.user);
+    return ark->base.problem.rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot), ark->base.problem.user);
 }
 
 /* One half of the IMEX split, from the cached rhs_split at (t, y). */
 static int split_half(sunrealtype t, N_Vector y, N_Vector ydot, arkode_backend *ark, int implicit)
 {
     const double *yy = N_VGetArrayPointer(y);
-    size_t n = ark->n;
+    size_t n = ark->base.n;
     if (!(ark->cache_valid && ark->cache_t == t && memcmp(ark->cache_y, yy, n * sizeof *yy) == 0)) {
         ark->cache_valid = 0;
         ark->split_evals++;
-        int rc = ark->problem.rhs_split(t, yy, ark->cache_fe, ark->cache_fi, ark->problem.user);
+        int rc = ark->base.problem.rhs_split(t, yy, ark->cache_fe, ark->cache_fi, ark->base.problem.user);
         if (rc != 0)
             return rc;
         memcpy(ark->cache_y, yy, n * sizeof *yy);
@@ -198,7 +175,7 @@ static int implicit_half(sunrealtype t, N_Vector y, N_Vector ydot, void *user)
 static int roots_adapter(sunrealtype t, N_Vector y, sunrealtype *g, void *user)
 {
     arkode_backend *ark = user;
-    return ark->problem.roots(t, N_VGetArrayPointer(y), g, ark->problem.user);
+    return ark->base.problem.roots(t, N_VGetArrayPointer(y), g, ark->base.problem.user);
 }
 
 static ARKRhsFn explicit_fn(const arkode_backend *ark)
@@ -215,7 +192,8 @@ static ARKRhsFn implicit_fn(const arkode_backend *ark)
     return ark->variant.kind == KIND_EXPLICIT ? NULL : rhs_adapter;
 }
 
-static void add_counters(arkode_backend *ark, bk_solver_counters *c)
+/* The counters of the current start, as ARKODE reports them (rhs_split calls for a split). */
+static bk_solver_counters this_start(const arkode_backend *ark)
 {
     long steps = 0, fe = 0, fi = 0, fls = 0, roots = 0, fails = 0, iters = 0;
     if (ark->arkode) {
@@ -228,47 +206,27 @@ static void add_counters(arkode_backend *ark, bk_solver_counters *c)
             ARKStepGetNumLinRhsEvals(ark->arkode, &fls);
         }
     }
-    c->steps += steps;
-    c->rhs_evals += (ark->split ? ark->split_evals : fe + fi) + fls;
-    c->root_evals += roots;
-    c->err_test_fails += fails;
-    c->nonlin_iters += iters;
+    long rhs = (ark->split ? ark->split_evals : fe + fi) + fls;
+    return (bk_solver_counters){.steps = steps, .rhs_evals = rhs, .root_evals = roots,
+                                .err_test_fails = fails, .nonlin_iters = iters};
 }
 
 static void free_objects(arkode_backend *ark)
 {
     if (ark->arkode)
         ARKStepFree(&ark->arkode);
-    if (ark->linear_solver)
-        SUNLinSolFree(ark->linear_solver);
-    if (ark->matrix)
-        SUNMatDestroy(ark->matrix);
-    if (ark->y)
-        N_VDestroy(ark->y);
-    if (ark->atol)
-        N_VDestroy(ark->atol);
-    if (ark->work)
-        N_VDestroy(ark->work);
     free(ark->cache_y);
     free(ark->cache_fe);
     free(ark->cache_fi);
     ark->cache_y = ark->cache_fe = ark->cache_fi = NULL;
     ark->cache_valid = 0;
     ark->arkode = NULL;
-    ark->linear_solver = NULL;
-    ark->matrix = NULL;
-    ark->y = ark->atol = ark->work = NULL;
-    ark->n = 0;
-    ark->n_roots = -1;
+    bk_sundials_free_objects(&ark->base);
 }
 
-static int fail(arkode_backend *ark, bk_error *err, const char *what, int flag)
+static int fail(const arkode_backend *ark, bk_error *err, const char *what, int flag)
 {
-    char *flag_name = ARKStepGetReturnFlagName(flag); /* malloc'ed by SUNDIALS */
-    BK_FAIL(err, BK_ERR_SOLVER, "ARKODE: %s failed (flag %d: %s)%s%s", what, flag,
-            flag_name ? flag_name : "?", ark->message[0] ? ": " : "", ark->message);
-    free(flag_name);
-    return BK_ERR_SOLVER;
+    return bk_sundials_fail(&ark->base, err, what, flag);
 }
 
 /* The exact Jacobian of the implicit part: the whole right-hand side's, or (IMEX) the
@@ -281,20 +239,21 @@ static int jacobian_adapter(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix ja
     (void)tmp2;
     (void)tmp3;
     arkode_backend *ark = user;
-    bk_ode_problem implicit_part = ark->problem;
+    bk_ode_problem implicit_part = ark->base.problem;
     if (ark->split)
-        implicit_part.jacobian = ark->problem.jacobian_implicit;
+        implicit_part.jacobian = ark->base.problem.jacobian_implicit;
     return bk_sundials_jacobian(&implicit_part, t, N_VGetArrayPointer(y), jac, 1.0, 0.0);
 }
 
 static int create(void **mem, const bk_solver_options *options, const ark_variant *variant,
                   bk_error *err)
 {
-    arkode_backend *ark = calloc(1, sizeof *ark);
-    if (!ark)
-        return BK_FAIL(err, BK_ERR_NOMEM, "ARKODE back-end: out of memory");
+    int rc = bk_sundials_create(mem, sizeof(arkode_backend), "ARKODE", ARKStepGetReturnFlagName,
+                                options, err);
+    if (rc != BK_OK)
+        return rc;
+    arkode_backend *ark = *mem;
     ark->variant = *variant;
-    ark->options = *options;
     /* A chosen table replaces the method's own (only arkode_erk and arkode_dirk take one). */
     int chosen = variant->takes_table && options->arkode_table[0] && strcmp(options->arkode_table, "default") != 0
                      ? table_id(variant->kind, options->arkode_table)
@@ -303,12 +262,6 @@ static int create(void **mem, const bk_solver_options *options, const ark_varian
         ark->variant.erk = (ARKODE_ERKTableID)chosen;
     else if (chosen >= 0 && variant->kind == KIND_IMPLICIT)
         ark->variant.dirk = (ARKODE_DIRKTableID)chosen;
-    ark->n_roots = -1;
-    if (SUNContext_Create(NULL, &ark->ctx) != 0) {
-        free(ark);
-        return BK_FAIL(err, BK_ERR_SOLVER, "ARKODE back-end: SUNContext_Create failed");
-    }
-    *mem = ark;
     return BK_OK;
 }
 
@@ -337,33 +290,24 @@ static int create_imex(void **mem, const bk_solver_options *options, bk_error *e
     return create(mem, options, &variant_imex, err);
 }
 
-static int use_band(const arkode_backend *ark, size_t n)
-{
-    if (strcmp(ark->options.linear_solver, "band") == 0)
-        return 1;
-    if (strcmp(ark->options.linear_solver, "dense") == 0)
-        return 0;
-    return n > BAND_THRESHOLD && 2 * ark->problem.half_bandwidth + 1 < n;
-}
-
 static int build_objects(arkode_backend *ark, size_t n, double t0, const double *y0, bk_error *err)
 {
-    sunindextype len = (sunindextype)n;
-    ark->y = N_VNew_Serial(len, ark->ctx);
-    ark->atol = N_VNew_Serial(len, ark->ctx);
-    ark->work = N_VNew_Serial(len, ark->ctx);
+    bk_sundials_base *base = &ark->base;
+    int rc = bk_sundials_new_vectors(base, n, err);
+    if (rc != BK_OK)
+        return rc;
     if (ark->split) {
         ark->cache_y = malloc(n * sizeof *ark->cache_y);
         ark->cache_fe = malloc(n * sizeof *ark->cache_fe);
         ark->cache_fi = malloc(n * sizeof *ark->cache_fi);
+        if (!ark->cache_y || !ark->cache_fe || !ark->cache_fi)
+            return bk_sundials_no_memory(base, n, err);
     }
-    if (!ark->y || !ark->atol || !ark->work || (ark->split && (!ark->cache_y || !ark->cache_fe || !ark->cache_fi)))
-        return BK_FAIL(err, BK_ERR_NOMEM, "ARKODE: cannot allocate a problem of size %zu", n);
-    memcpy(N_VGetArrayPointer(ark->y), y0, n * sizeof *y0);
-    ark->arkode = ARKStepCreate(explicit_fn(ark), implicit_fn(ark), t0, ark->y, ark->ctx);
+    memcpy(N_VGetArrayPointer(base->y), y0, n * sizeof *y0);
+    ark->arkode = ARKStepCreate(explicit_fn(ark), implicit_fn(ark), t0, base->y, base->ctx);
     if (!ark->arkode)
         return BK_FAIL(err, BK_ERR_NOMEM, "ARKODE: ARKStepCreate failed (size %zu)", n);
-    ARKStepSetErrHandlerFn(ark->arkode, capture_message, ark);
+    ARKStepSetErrHandlerFn(ark->arkode, bk_sundials_capture_message, base);
     ARKStepSetUserData(ark->arkode, ark);
     ARKStepSetNoInactiveRootWarn(ark->arkode);
     /* Without a split, arkode_imex integrates everything with the pair's ESDIRK half. */
@@ -372,20 +316,12 @@ static int build_objects(arkode_backend *ark, size_t n, double t0, const double 
     if (flag != ARK_SUCCESS)
         return fail(ark, err, "ARKStepSetTableNum", flag);
     if (implicit_fn(ark)) {
-        if (use_band(ark, n)) {
-            sunindextype bw = (sunindextype)ark->problem.half_bandwidth;
-            ark->matrix = SUNBandMatrix(len, bw, bw, ark->ctx);
-            ark->linear_solver = ark->matrix ? SUNLinSol_Band(ark->y, ark->matrix, ark->ctx) : NULL;
-        } else {
-            ark->matrix = SUNDenseMatrix(len, len, ark->ctx);
-            ark->linear_solver = ark->matrix ? SUNLinSol_Dense(ark->y, ark->matrix, ark->ctx) : NULL;
-        }
-        if (!ark->linear_solver)
-            return BK_FAIL(err, BK_ERR_NOMEM, "ARKODE: cannot create the linear solver (n = %zu)", n);
-        flag = ARKStepSetLinearSolver(ark->arkode, ark->linear_solver, ark->matrix);
+        if ((rc = bk_sundials_new_linear_solver(base, n, err)) != BK_OK)
+            return rc;
+        flag = ARKStepSetLinearSolver(ark->arkode, base->linear_solver, base->matrix);
         if (flag != ARK_SUCCESS)
             return fail(ark, err, "ARKStepSetLinearSolver", flag);
-        if ((ark->split ? ark->problem.jacobian_implicit : ark->problem.jacobian) &&
+        if ((ark->split ? base->problem.jacobian_implicit : base->problem.jacobian) &&
         (flag = ARKStepSetJacFn(ark->arkode, jacobian_adapter)) != ARK_SUCCESS)
             return fail(ark, err, "ARKStepSetJacFn", flag);
         /* Rebuild the Newton matrix whenever gamma = h a_ii changes.  With ARKODE 6.4.1's
@@ -399,7 +335,7 @@ static int build_objects(arkode_backend *ark, size_t n, double t0, const double 
         if ((flag = ARKStepSetDeltaGammaMax(ark->arkode, 1e-9)) != ARK_SUCCESS)
             return fail(ark, err, "ARKStepSetDeltaGammaMax", flag);
     }
-    ark->n = n;
+    base->n = n;
     return BK_OK;
 }
 
@@ -407,17 +343,16 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
                  const double *atol, size_t n, double t_stop, bk_error *err)
 {
     arkode_backend *ark = mem;
-    ark->problem = *problem;
-    ark->message[0] = '\0';
-    add_counters(ark, &ark->done);
+    bk_sundials_base *base = &ark->base;
+    bk_sundials_begin_start(base, problem, this_start(ark));
     ark->split_evals = 0;
     ark->cache_valid = 0; /* the scene behind the right-hand side changed */
     int split = ark->variant.kind == KIND_IMEX && problem->rhs_split;
     int flag;
-    if (ark->arkode && ark->n == n && ark->split == split) {
-        memcpy(N_VGetArrayPointer(ark->y), y0, n * sizeof *y0);
+    if (ark->arkode && base->n == n && ark->split == split) {
+        memcpy(N_VGetArrayPointer(base->y), y0, n * sizeof *y0);
         /* Keeps the tables, the linear solver and every option set before. */
-        flag = ARKStepReInit(ark->arkode, explicit_fn(ark), implicit_fn(ark), t0, ark->y);
+        flag = ARKStepReInit(ark->arkode, explicit_fn(ark), implicit_fn(ark), t0, base->y);
         if (flag != ARK_SUCCESS)
             return fail(ark, err, "ARKStepReInit", flag);
     } else {
@@ -429,15 +364,15 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
             return rc;
         }
     }
-    memcpy(N_VGetArrayPointer(ark->atol), atol, n * sizeof *atol);
-    if ((flag = ARKStepSVtolerances(ark->arkode, ark->options.rtol, ark->atol)) != ARK_SUCCESS)
+    memcpy(N_VGetArrayPointer(base->atol), atol, n * sizeof *atol);
+    if ((flag = ARKStepSVtolerances(ark->arkode, base->options.rtol, base->atol)) != ARK_SUCCESS)
         return fail(ark, err, "ARKStepSVtolerances", flag);
-    if ((int)problem->n_roots != ark->n_roots) {
+    if ((int)problem->n_roots != base->n_roots) {
         flag = ARKStepRootInit(ark->arkode, (int)problem->n_roots,
                                problem->n_roots ? roots_adapter : NULL);
         if (flag != ARK_SUCCESS)
             return fail(ark, err, "ARKStepRootInit", flag);
-        ark->n_roots = (int)problem->n_roots;
+        base->n_roots = (int)problem->n_roots;
     }
     if (problem->n_roots > 0) {
         /* ARKODE copies the directions; the cast only drops const from its prototype. */
@@ -447,10 +382,10 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     }
     if ((flag = ARKStepSetStopTime(ark->arkode, t_stop)) != ARK_SUCCESS)
         return fail(ark, err, "ARKStepSetStopTime", flag);
-    if (isfinite(ark->options.max_step) && ark->options.max_step > 0 &&
-        (flag = ARKStepSetMaxStep(ark->arkode, ark->options.max_step)) != ARK_SUCCESS)
+    if (isfinite(base->options.max_step) && base->options.max_step > 0 &&
+        (flag = ARKStepSetMaxStep(ark->arkode, base->options.max_step)) != ARK_SUCCESS)
         return fail(ark, err, "ARKStepSetMaxStep", flag);
-    ark->t_stop = t_stop;
+    base->t_stop = t_stop;
     return BK_OK;
 }
 
@@ -458,9 +393,9 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
 {
     arkode_backend *ark = mem;
     sunrealtype t = 0.0;
-    int flag = ARKStepEvolve(ark->arkode, ark->t_stop, ark->y, &t, ARK_ONE_STEP);
+    int flag = ARKStepEvolve(ark->arkode, ark->base.t_stop, ark->base.y, &t, ARK_ONE_STEP);
     *t_reached = t;
-    memcpy(y, N_VGetArrayPointer(ark->y), ark->n * sizeof *y);
+    memcpy(y, N_VGetArrayPointer(ark->base.y), ark->base.n * sizeof *y);
     switch (flag) {
     case ARK_SUCCESS:
         return BK_STEP_OK;
@@ -476,10 +411,10 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
 static int interpolate(void *mem, double t, double *y, bk_error *err)
 {
     arkode_backend *ark = mem;
-    int flag = ARKStepGetDky(ark->arkode, t, 0, ark->work);
+    int flag = ARKStepGetDky(ark->arkode, t, 0, ark->base.work);
     if (flag != ARK_SUCCESS)
         return fail(ark, err, "ARKStepGetDky", flag);
-    memcpy(y, N_VGetArrayPointer(ark->work), ark->n * sizeof *y);
+    memcpy(y, N_VGetArrayPointer(ark->base.work), ark->base.n * sizeof *y);
     return BK_OK;
 }
 
@@ -502,8 +437,7 @@ static int root_info(void *mem, int *found)
 static void counters(void *mem, bk_solver_counters *c)
 {
     arkode_backend *ark = mem;
-    *c = ark->done;
-    add_counters(ark, c);
+    bk_sundials_counters(&ark->base, this_start(ark), c);
 }
 
 static void destroy(void *mem)
@@ -512,8 +446,7 @@ static void destroy(void *mem)
     if (!ark)
         return;
     free_objects(ark);
-    SUNContext_Free(&ark->ctx);
-    free(ark);
+    bk_sundials_destroy(&ark->base);
 }
 
 #define ARKODE_BACKEND(NAME, CREATE, CHECK, DOC)                                                \

@@ -20,59 +20,36 @@
  * is just past the crossing.  rhs_evals counts residual evaluations (one f each), those for
  * a difference-quotient Jacobian, and the f(t0, y0) of every start. */
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <ida/ida.h>
 #include <nvector/nvector_serial.h>
-#include <sundials/sundials_context.h>
-#include <sunlinsol/sunlinsol_band.h>
-#include <sunlinsol/sunlinsol_dense.h>
-#include <sunmatrix/sunmatrix_band.h>
-#include <sunmatrix/sunmatrix_dense.h>
 
 #include "bksim/solver.h"
+#include "sundials_common.h"
 #include "sundials_jacobian.h"
 
-/* Above this size "auto" picks the band solver (when the layout is banded); as cvode.c. */
-#define BAND_THRESHOLD 16
-
 typedef struct ida_backend {
-    bk_solver_options options;
-    SUNContext ctx;
+    bk_sundials_base base;        /* first: the state is its base (sundials_common.h) */
     void *ida;
-    N_Vector y, yp, atol, id, work;
-    SUNMatrix matrix;
-    SUNLinearSolver linear_solver;
-    size_t n;                     /* size the IDA objects were built for */
-    int n_roots;                  /* size RootInit was called with */
-    bk_ode_problem problem;
-    double t_stop;
+    N_Vector yp, id;
     double *yp0;                  /* f(t0, y0) at the last start, capacity entries */
     size_t capacity;
-    bk_solver_counters done;      /* counters of finished starts */
-    char message[512];            /* last message from IDA's error handler */
 } ida_backend;
-
-static void capture_message(int error_code, const char *module, const char *function,
-                            char *msg, void *user)
-{
-    ida_backend *ida = user;
-    snprintf(ida->message, sizeof ida->message, "%s (%s, code %d)", msg,
-             function ? function : module, error_code);
-}
+_Static_assert(offsetof(ida_backend, base) == 0, "the state is allocated and freed through its base");
 
 /* F = diag(id) y' - f(t, y); f's return convention (> 0 recoverable, < 0 fatal) is IDA's. */
 static int residual(sunrealtype t, N_Vector y, N_Vector yp, N_Vector r, void *user)
 {
     ida_backend *ida = user;
     double *rr = N_VGetArrayPointer(r);
-    int rc = ida->problem.rhs(t, N_VGetArrayPointer(y), rr, ida->problem.user);
+    int rc = ida->base.problem.rhs(t, N_VGetArrayPointer(y), rr, ida->base.problem.user);
     if (rc != 0)
         return rc;
-    const double *ypp = N_VGetArrayPointer(yp), *id = ida->problem.differential_id;
+    const double *ypp = N_VGetArrayPointer(yp), *id = ida->base.problem.differential_id;
     size_t n = (size_t)N_VGetLength(r);
     for (size_t k = 0; k < n; ++k)
         rr[k] = (id && id[k] == 0.0 ? 0.0 : ypp[k]) - rr[k];
@@ -83,10 +60,11 @@ static int roots_adapter(sunrealtype t, N_Vector y, N_Vector yp, sunrealtype *g,
 {
     (void)yp;
     ida_backend *ida = user;
-    return ida->problem.roots(t, N_VGetArrayPointer(y), g, ida->problem.user);
+    return ida->base.problem.roots(t, N_VGetArrayPointer(y), g, ida->base.problem.user);
 }
 
-static void add_counters(ida_backend *ida, bk_solver_counters *c)
+/* The counters of the current start, as IDA reports them. */
+static bk_solver_counters this_start(const ida_backend *ida)
 {
     long steps = 0, res = 0, res_ls = 0, roots = 0, fails = 0, iters = 0;
     if (ida->ida) {
@@ -97,43 +75,26 @@ static void add_counters(ida_backend *ida, bk_solver_counters *c)
         IDAGetNumErrTestFails(ida->ida, &fails);
         IDAGetNumNonlinSolvIters(ida->ida, &iters);
     }
-    c->steps += steps;
-    c->rhs_evals += res + res_ls;
-    c->root_evals += roots;
-    c->err_test_fails += fails;
-    c->nonlin_iters += iters;
+    return (bk_solver_counters){.steps = steps, .rhs_evals = res + res_ls, .root_evals = roots,
+                                .err_test_fails = fails, .nonlin_iters = iters};
 }
 
 static void free_objects(ida_backend *ida)
 {
     if (ida->ida)
         IDAFree(&ida->ida);
-    if (ida->linear_solver)
-        SUNLinSolFree(ida->linear_solver);
-    if (ida->matrix)
-        SUNMatDestroy(ida->matrix);
-    N_Vector *owned[] = {&ida->y, &ida->yp, &ida->atol, &ida->id, &ida->work};
-    const size_t n_owned = sizeof(owned) / sizeof(owned[0]);
-    for (size_t k = 0; k < n_owned; ++k) {
-        N_Vector *slot = owned[k];
-        if (*slot)
-            N_VDestroy(*slot);
-        *slot = NULL;
-    }
+    if (ida->yp)
+        N_VDestroy(ida->yp);
+    if (ida->id)
+        N_VDestroy(ida->id);
     ida->ida = NULL;
-    ida->linear_solver = NULL;
-    ida->matrix = NULL;
-    ida->n = 0;
-    ida->n_roots = -1;
+    ida->yp = ida->id = NULL;
+    bk_sundials_free_objects(&ida->base);
 }
 
-static int fail(ida_backend *ida, bk_error *err, const char *what, int flag)
+static int fail(const ida_backend *ida, bk_error *err, const char *what, int flag)
 {
-    char *flag_name = IDAGetReturnFlagName(flag); /* malloc'ed by SUNDIALS */
-    BK_FAIL(err, BK_ERR_SOLVER, "IDA: %s failed (flag %d: %s)%s%s", what, flag,
-            flag_name ? flag_name : "?", ida->message[0] ? ": " : "", ida->message);
-    free(flag_name);
-    return BK_ERR_SOLVER;
+    return bk_sundials_fail(&ida->base, err, what, flag);
 }
 
 /* d(residual)/dy + cj d(residual)/dy' for the residual diag(id) y' - f(t, y): cj diag(id) - J. */
@@ -146,68 +107,41 @@ static int jacobian_adapter(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector 
     (void)tmp2;
     (void)tmp3;
     ida_backend *ida = user;
-    return bk_sundials_jacobian(&ida->problem, t, N_VGetArrayPointer(y), jac, -1.0, cj);
+    return bk_sundials_jacobian(&ida->base.problem, t, N_VGetArrayPointer(y), jac, -1.0, cj);
 }
 
 static int create(void **mem, const bk_solver_options *options, bk_error *err)
 {
-    ida_backend *ida = calloc(1, sizeof *ida);
-    if (!ida)
-        return BK_FAIL(err, BK_ERR_NOMEM, "IDA back-end: out of memory");
-    ida->options = *options;
-    ida->n_roots = -1;
-    if (SUNContext_Create(NULL, &ida->ctx) != 0) {
-        free(ida);
-        return BK_FAIL(err, BK_ERR_SOLVER, "IDA back-end: SUNContext_Create failed");
-    }
-    *mem = ida;
-    return BK_OK;
-}
-
-static int use_band(const ida_backend *ida, size_t n)
-{
-    if (strcmp(ida->options.linear_solver, "band") == 0)
-        return 1;
-    if (strcmp(ida->options.linear_solver, "dense") == 0)
-        return 0;
-    return n > BAND_THRESHOLD && 2 * ida->problem.half_bandwidth + 1 < n;
+    return bk_sundials_create(mem, sizeof(ida_backend), "IDA", IDAGetReturnFlagName, options, err);
 }
 
 static int build_objects(ida_backend *ida, size_t n, double t0, const double *y0,
                          const double *yp0, bk_error *err)
 {
-    sunindextype len = (sunindextype)n;
-    ida->y = N_VNew_Serial(len, ida->ctx);
-    ida->yp = N_VNew_Serial(len, ida->ctx);
-    ida->atol = N_VNew_Serial(len, ida->ctx);
-    ida->id = N_VNew_Serial(len, ida->ctx);
-    ida->work = N_VNew_Serial(len, ida->ctx);
-    ida->ida = IDACreate(ida->ctx);
-    if (!ida->y || !ida->yp || !ida->atol || !ida->id || !ida->work || !ida->ida)
-        return BK_FAIL(err, BK_ERR_NOMEM, "IDA: cannot allocate a problem of size %zu", n);
-    memcpy(N_VGetArrayPointer(ida->y), y0, n * sizeof *y0);
+    bk_sundials_base *base = &ida->base;
+    int rc = bk_sundials_new_vectors(base, n, err);
+    if (rc != BK_OK)
+        return rc;
+    ida->yp = N_VNew_Serial((sunindextype)n, base->ctx);
+    ida->id = N_VNew_Serial((sunindextype)n, base->ctx);
+    ida->ida = IDACreate(base->ctx);
+    if (!ida->yp || !ida->id || !ida->ida)
+        return bk_sundials_no_memory(base, n, err);
+    memcpy(N_VGetArrayPointer(base->y), y0, n * sizeof *y0);
     memcpy(N_VGetArrayPointer(ida->yp), yp0, n * sizeof *yp0);
-    IDASetErrHandlerFn(ida->ida, capture_message, ida);
-    int flag = IDAInit(ida->ida, residual, t0, ida->y, ida->yp);
+    IDASetErrHandlerFn(ida->ida, bk_sundials_capture_message, base);
+    int flag = IDAInit(ida->ida, residual, t0, base->y, ida->yp);
     if (flag != IDA_SUCCESS)
         return fail(ida, err, "IDAInit", flag);
     IDASetUserData(ida->ida, ida);
     IDASetNoInactiveRootWarn(ida->ida);
-    if (use_band(ida, n)) {
-        sunindextype bw = (sunindextype)ida->problem.half_bandwidth;
-        ida->matrix = SUNBandMatrix(len, bw, bw, ida->ctx);
-        ida->linear_solver = ida->matrix ? SUNLinSol_Band(ida->y, ida->matrix, ida->ctx) : NULL;
-    } else {
-        ida->matrix = SUNDenseMatrix(len, len, ida->ctx);
-        ida->linear_solver = ida->matrix ? SUNLinSol_Dense(ida->y, ida->matrix, ida->ctx) : NULL;
-    }
-    if (!ida->linear_solver)
-        return BK_FAIL(err, BK_ERR_NOMEM, "IDA: cannot create the linear solver (n = %zu)", n);
-    if ((flag = IDASetLinearSolver(ida->ida, ida->linear_solver, ida->matrix)) != IDA_SUCCESS)
+    if ((rc = bk_sundials_new_linear_solver(base, n, err)) != BK_OK)
+        return rc;
+    if ((flag = IDASetLinearSolver(ida->ida, base->linear_solver, base->matrix)) != IDA_SUCCESS)
         return fail(ida, err, "IDASetLinearSolver", flag);
-    if (ida->problem.jacobian && (flag = IDASetJacFn(ida->ida, jacobian_adapter)) != IDA_SUCCESS)
+    if (base->problem.jacobian && (flag = IDASetJacFn(ida->ida, jacobian_adapter)) != IDA_SUCCESS)
         return fail(ida, err, "IDASetJacFn", flag);
-    ida->n = n;
+    base->n = n;
     return BK_OK;
 }
 
@@ -215,18 +149,17 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
                  const double *atol, size_t n, double t_stop, bk_error *err)
 {
     ida_backend *ida = mem;
-    ida->problem = *problem;
-    ida->message[0] = '\0';
-    add_counters(ida, &ida->done);
+    bk_sundials_base *base = &ida->base;
+    bk_sundials_begin_start(base, problem, this_start(ida));
     if (n > ida->capacity) {
         double *grown = realloc(ida->yp0, n * sizeof *grown);
         if (!grown)
-            return BK_FAIL(err, BK_ERR_NOMEM, "IDA: cannot allocate a problem of size %zu", n);
+            return bk_sundials_no_memory(base, n, err);
         ida->yp0 = grown;
         ida->capacity = n;
     }
     /* The consistent initial derivative: f, and 0 for the algebraic rows. */
-    ida->done.rhs_evals++;
+    base->done.rhs_evals++;
     int rc = problem->rhs(t0, y0, ida->yp0, problem->user);
     if (rc != 0)
         return BK_FAIL(err, BK_ERR_SOLVER,
@@ -235,10 +168,10 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
         if (problem->differential_id[k] == 0.0)
             ida->yp0[k] = 0.0;
     int flag;
-    if (ida->ida && ida->n == n) {
-        memcpy(N_VGetArrayPointer(ida->y), y0, n * sizeof *y0);
+    if (ida->ida && base->n == n) {
+        memcpy(N_VGetArrayPointer(base->y), y0, n * sizeof *y0);
         memcpy(N_VGetArrayPointer(ida->yp), ida->yp0, n * sizeof *y0);
-        if ((flag = IDAReInit(ida->ida, t0, ida->y, ida->yp)) != IDA_SUCCESS)
+        if ((flag = IDAReInit(ida->ida, t0, base->y, ida->yp)) != IDA_SUCCESS)
             return fail(ida, err, "IDAReInit", flag);
     } else {
         free_objects(ida);
@@ -254,14 +187,14 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
         N_VConst(1.0, ida->id);
     if ((flag = IDASetId(ida->ida, ida->id)) != IDA_SUCCESS)
         return fail(ida, err, "IDASetId", flag);
-    memcpy(N_VGetArrayPointer(ida->atol), atol, n * sizeof *atol);
-    if ((flag = IDASVtolerances(ida->ida, ida->options.rtol, ida->atol)) != IDA_SUCCESS)
+    memcpy(N_VGetArrayPointer(base->atol), atol, n * sizeof *atol);
+    if ((flag = IDASVtolerances(ida->ida, base->options.rtol, base->atol)) != IDA_SUCCESS)
         return fail(ida, err, "IDASVtolerances", flag);
-    if ((int)problem->n_roots != ida->n_roots) {
+    if ((int)problem->n_roots != base->n_roots) {
         flag = IDARootInit(ida->ida, (int)problem->n_roots, problem->n_roots ? roots_adapter : NULL);
         if (flag != IDA_SUCCESS)
             return fail(ida, err, "IDARootInit", flag);
-        ida->n_roots = (int)problem->n_roots;
+        base->n_roots = (int)problem->n_roots;
     }
     if (problem->n_roots > 0) {
         /* IDA copies the directions; the cast only drops const from its prototype. */
@@ -271,10 +204,10 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     }
     if ((flag = IDASetStopTime(ida->ida, t_stop)) != IDA_SUCCESS)
         return fail(ida, err, "IDASetStopTime", flag);
-    if (isfinite(ida->options.max_step) && ida->options.max_step > 0 &&
-        (flag = IDASetMaxStep(ida->ida, ida->options.max_step)) != IDA_SUCCESS)
+    if (isfinite(base->options.max_step) && base->options.max_step > 0 &&
+        (flag = IDASetMaxStep(ida->ida, base->options.max_step)) != IDA_SUCCESS)
         return fail(ida, err, "IDASetMaxStep", flag);
-    ida->t_stop = t_stop;
+    base->t_stop = t_stop;
     return BK_OK;
 }
 
@@ -282,9 +215,9 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
 {
     ida_backend *ida = mem;
     sunrealtype t = 0.0;
-    int flag = IDASolve(ida->ida, ida->t_stop, &t, ida->y, ida->yp, IDA_ONE_STEP);
+    int flag = IDASolve(ida->ida, ida->base.t_stop, &t, ida->base.y, ida->yp, IDA_ONE_STEP);
     *t_reached = t;
-    memcpy(y, N_VGetArrayPointer(ida->y), ida->n * sizeof *y);
+    memcpy(y, N_VGetArrayPointer(ida->base.y), ida->base.n * sizeof *y);
     switch (flag) {
     case IDA_SUCCESS:
         return BK_STEP_OK;
@@ -300,10 +233,10 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
 static int interpolate(void *mem, double t, double *y, bk_error *err)
 {
     ida_backend *ida = mem;
-    int flag = IDAGetDky(ida->ida, t, 0, ida->work);
+    int flag = IDAGetDky(ida->ida, t, 0, ida->base.work);
     if (flag != IDA_SUCCESS)
         return fail(ida, err, "IDAGetDky", flag);
-    memcpy(y, N_VGetArrayPointer(ida->work), ida->n * sizeof *y);
+    memcpy(y, N_VGetArrayPointer(ida->base.work), ida->base.n * sizeof *y);
     return BK_OK;
 }
 
@@ -326,8 +259,7 @@ static int root_info(void *mem, int *found)
 static void counters(void *mem, bk_solver_counters *c)
 {
     ida_backend *ida = mem;
-    *c = ida->done;
-    add_counters(ida, c);
+    bk_sundials_counters(&ida->base, this_start(ida), c);
 }
 
 static void destroy(void *mem)
@@ -336,9 +268,8 @@ static void destroy(void *mem)
     if (!ida)
         return;
     free_objects(ida);
-    SUNContext_Free(&ida->ctx);
     free(ida->yp0);
-    free(ida);
+    bk_sundials_destroy(&ida->base);
 }
 
 const bk_solver_backend bk_solver_ida = {
