@@ -1,0 +1,443 @@
+/* From checked entries to a bk_config: the chain (model, blocks, friction, driver) or a
+ * prescribed-motion scene, then the solver, run and output options.  Each value comes from
+ * the most specific section that gives it ([block.I] over [block], [friction.I] over
+ * [friction]) or from the key's default; what no single value can show is checked here:
+ * missing keys, a law's parameters against each other, derived defaults and initial energies
+ * that overflow, the method against the scene, and the output's size guards. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_rng.h>
+
+#include "bksim/solver.h"
+#include "config_impl.h"
+#include "output/layout.h"
+
+static void report_missing(loader *ld, const char *section, const bk_param *param, const key_def *def)
+{
+    char allowed[1536];
+    bk_config_format_allowed(def, param, allowed, sizeof allowed);
+    bk_config_report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [%s] %s: required key missing (allowed: %s)", ld->name,
+                     section, param->key, allowed);
+}
+
+/* Value of a key in [section] (checked), or the definition's default. */
+static double value_of(loader *ld, const char *section, const char *key)
+{
+    entry *e = bk_config_lookup(ld, section, key);
+    if (e)
+        return e->number;
+    const key_def *def = bk_config_find_key(section, key);
+    if (def->type == BK_KEY_CHOICE && def->default_text)
+        for (size_t i = 0; bk_config_enum_choice(def, i); ++i)
+            if (strcmp(bk_config_enum_choice(def, i), def->default_text) == 0)
+                return (double)i;
+    if (def->type == BK_KEY_FIELDS)
+        return (double)BK_FIELD_ALL;
+    if (def->param.flags & BK_PARAM_REQUIRED)
+        report_missing(ld, section, &def->param, def);
+    return def->param.default_value;
+}
+
+/* A block key: [block.I] over [block] over the default. */
+static double block_value(loader *ld, size_t i, const char *key, int *given)
+{
+    char section[SECTION_LEN];
+    snprintf(section, sizeof section, "block.%zu", i);
+    entry *e = bk_config_lookup(ld, section, key);
+    if (!e)
+        e = bk_config_lookup(ld, "block", key);
+    *given = e != NULL;
+    return e ? e->number : bk_config_find_key("block", key)->param.default_value;
+}
+
+/* Friction of block i: its law and parameters, completed and validated. */
+static void build_friction(loader *ld, bk_block *b, size_t i, double driver_speed)
+{
+    char section[SECTION_LEN];
+    snprintf(section, sizeof section, "friction.%zu", i);
+    entry *own_law = bk_config_lookup(ld, section, "law");
+    entry *base_law = bk_config_lookup(ld, "friction", "law");
+    entry *law_entry = own_law ? own_law : base_law;
+    if (!law_entry) {
+        report_missing(ld, "friction", &bk_config_find_key("friction", "law")->param,
+                       bk_config_find_key("friction", "law"));
+        return;
+    }
+    const bk_friction_law *law = bk_friction_law_find(law_entry->value);
+    if (!law)
+        return; /* reported at its line */
+    /* Parameters of [friction] apply unless this block names a different law. */
+    int inherit = !own_law || (base_law && strcmp(own_law->value, base_law->value) == 0);
+    const char *param_section = own_law ? section : "friction";
+    entry *origin[BK_FRICTION_MAX_PARAMS] = {0};
+    b->law = law;
+    for (size_t p = 0; p < law->n_params; ++p) {
+        const bk_param *param = &law->params[p];
+        entry *e = bk_config_lookup(ld, section, param->key);
+        if (!e && inherit)
+            e = bk_config_lookup(ld, "friction", param->key);
+        origin[p] = e;
+        if (e) {
+            b->friction_params[p] = e->number;
+        } else if (param->flags & BK_PARAM_REQUIRED) {
+            report_missing(ld, param_section, param, NULL);
+            b->friction_params[p] = NAN;
+        } else {
+            b->friction_params[p] = param->default_value;
+        }
+    }
+    if (law->complete) {
+        bk_friction_context ctx = {fabs(driver_speed), b->normal_force};
+        law->complete(b->friction_params, &ctx);
+        /* A default derived from other values (theta_init = L0 / driver speed) can overflow; a NaN
+         * one is the law's to report (validate says which value it needs). */
+        for (size_t p = 0; p < law->n_params; ++p)
+            if (!origin[p] && isinf(b->friction_params[p]) && ld->error_rank == LONG_MAX) {
+                bk_config_report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [%s] %s: its default for block %zu is not finite (%g); "
+                                 "set it (allowed: %g < %s < %g)", ld->name, param_section, law->params[p].key, i,
+                                 b->friction_params[p], law->params[p].min, law->params[p].key, law->params[p].max);
+                return;
+            }
+    }
+    if (law->validate) {
+        char msg[256];
+        int bad = law->validate(b->friction_params, msg, sizeof msg);
+        entry *at = bad >= 0 ? origin[bad] : NULL;
+        /* The same conflict in every block of a long chain is reported once: only an
+         * earlier-ranked one is worth the message. */
+        if (bad >= 0 && !(at && at->rank >= ld->error_rank)) {
+            /* A conflict with this block's own value is reported at the shared key: name the
+             * block and where its value came from. */
+            char block_note[640] = "";
+            for (size_t q = 0; q < law->n_params && (!at || strcmp(at->section, section) != 0); ++q)
+                if (origin[q] && strcmp(origin[q]->section, section) == 0) {
+                    char where[512];
+                    bk_config_location(ld, origin[q], where, sizeof where);
+                    if (snprintf(block_note, sizeof block_note, " (block %zu: %s sets [%s] %s = %s)", i,
+                                 where, section, origin[q]->key, origin[q]->value) < 0)
+                        block_note[0] = '\0';
+                    break;
+                }
+            if (at)
+                bk_config_report_entry(ld, at, "%s%s", msg, block_note);
+            else
+                bk_config_report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [%s] %s: %s%s", ld->name, param_section,
+                                 law->params[bad].key, msg, block_note);
+        }
+    }
+}
+
+static char *default_output_path(const char *name)
+{
+    const char *base = strrchr(name, '/');
+    base = base ? base + 1 : name;
+    size_t len = strlen(base);
+    if (len > 4 && strcmp(base + len - 4, ".ini") == 0)
+        len -= 4;
+    char *path = malloc(len + 4);
+    if (path)
+        snprintf(path, len + 4, "%.*s.h5", (int)len, base);
+    return path;
+}
+
+/* The energy audit needs finite energies: a start state whose energy overflows a double
+ * is refused here rather than reported as a NaN residual after the run. */
+static void check_initial_energy(loader *ld, const bk_model *m)
+{
+    double driver0 = bk_driver_position(&m->driver, 0.0);
+    for (size_t i = 0; i < m->n_blocks; ++i) {
+        const bk_block *b = &m->blocks[i];
+        const char *key = NULL;
+        double energy = 0.0;
+        if (!isfinite(energy = 0.5 * b->mass * b->v_init * b->v_init))
+            key = "v_init";
+        else if (!isfinite(energy = 0.5 * b->driver_stiffness * (driver0 - b->x_init) * (driver0 - b->x_init)))
+            key = "x_init";
+        if (!key)
+            continue;
+        char section[SECTION_LEN];
+        snprintf(section, sizeof section, "block.%zu", i);
+        entry *e = bk_config_lookup(ld, section, key);
+        if (!e)
+            e = bk_config_lookup(ld, "block", key);
+        if (!e)
+            e = bk_config_lookup(ld, "driver", "start_position");
+        const char *what = strcmp(key, "v_init") == 0 ? "kinetic" : "elastic";
+        if (e)
+            bk_config_report_entry(ld, e, "block %zu's initial %s energy overflows a double (%g J; allowed: a "
+                                   "finite energy)", i, what, energy);
+        else
+            bk_config_report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: block %zu's initial %s energy overflows a double",
+                             ld->name, i, what);
+        return;
+    }
+    double *x = malloc(m->n_blocks * sizeof *x);
+    if (!x) {
+        bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+        return;
+    }
+    for (size_t i = 0; i < m->n_blocks; ++i)
+        x[i] = m->blocks[i].x_init;
+    if (!isfinite(bk_model_elastic_energy(m, x, driver0)))
+        bk_config_report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: the chain's initial elastic energy overflows a double "
+                         "(check x_init, x_init_random and the stiffnesses)", ld->name);
+    free(x);
+}
+
+/* The chain: model, blocks, friction, driver. */
+static void build_chain(loader *ld, bk_config *c)
+{
+    double n_value = value_of(ld, "model", "n_blocks");
+    if (!(n_value >= 1))
+        return; /* reported */
+    size_t n = (size_t)n_value;
+    bk_model *m = bk_model_create(n);
+    if (!m) {
+        bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory for %zu blocks", ld->name, n);
+        return;
+    }
+    c->model = m;
+    m->boundary = (bk_boundary)(int)value_of(ld, "model", "boundary");
+    m->coupling_stiffness = value_of(ld, "model", "coupling_stiffness");
+    m->gravity = value_of(ld, "model", "gravity");
+    m->spring = (bk_spring)(int)value_of(ld, "driver", "spring");
+    m->driver.velocity = value_of(ld, "driver", "velocity");
+    m->driver.start_position = value_of(ld, "driver", "start_position");
+
+    static const char *const required[] = {"mass", "driver_stiffness"};
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    if (!rng) {
+        bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+        return;
+    }
+    gsl_rng_set(rng, (unsigned long)value_of(ld, "model", "seed"));
+    for (size_t i = 0; i < n; ++i) {
+        bk_block *b = &m->blocks[i];
+        int given;
+        for (size_t r = 0; r < 2; ++r) {
+            double value = block_value(ld, i, required[r], &given);
+            if (!given)
+                report_missing(ld, "block", &bk_config_find_key("block", required[r])->param,
+                               bk_config_find_key("block", required[r]));
+            if (r == 0)
+                b->mass = value;
+            else
+                b->driver_stiffness = value;
+        }
+        b->normal_force = block_value(ld, i, "normal_force", &given);
+        if (!given)
+            b->normal_force = b->mass * m->gravity;
+        if (!isfinite(b->normal_force) && ld->error_rank == LONG_MAX) {
+            bk_config_report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [block] normal_force: the default mass * gravity of block %zu "
+                             "overflows (%g kg * %g m/s^2; allowed: 0 < normal_force < inf N)", ld->name, i, b->mass, m->gravity);
+            break;
+        }
+        b->x_init = block_value(ld, i, "x_init", &given);
+        /* Drawn for every block, so a block's value does not depend on its neighbours' keys. */
+        b->x_init += block_value(ld, i, "x_init_random", &given) * (2.0 * gsl_rng_uniform(rng) - 1.0);
+        b->v_init = block_value(ld, i, "v_init", &given);
+        build_friction(ld, b, i, m->driver.velocity);
+        if (ld->error_rank != LONG_MAX && ld->error_rank >= RANK_MISSING)
+            break; /* one missing key is enough; don't repeat it for every block */
+    }
+    gsl_rng_free(rng);
+    bk_model_finalize(m);
+    check_initial_energy(ld, m);
+    c->t_end = value_of(ld, "run", "t_end");
+}
+
+/* A prescribed-motion scene: the schedule and one block's friction.  The chain's keys are
+ * optional here: normal_force defaults to mass * gravity, or 1 N without a mass. */
+static void build_prescribed(loader *ld, bk_config *c)
+{
+    entry *rates = bk_config_lookup(ld, "prescribed", "slip_rates");
+    entry *durations = bk_config_lookup(ld, "prescribed", "durations");
+    entry *distances = bk_config_lookup(ld, "prescribed", "distances");
+    if (!rates) {
+        report_missing(ld, "prescribed", &bk_config_find_key("prescribed", "slip_rates")->param,
+                       bk_config_find_key("prescribed", "slip_rates"));
+        return;
+    }
+    if (!durations == !distances) {
+        bk_config_report_entry(ld, durations ? distances : rates, "give exactly one of durations and distances");
+        return;
+    }
+    entry *lengths = durations ? durations : distances;
+    if (!lengths)
+        return; /* reported above */
+    size_t n = (size_t)rates->number;
+    if ((size_t)lengths->number != n) {
+        bk_config_report_entry(ld, lengths, "has %zu values, slip_rates has %zu", (size_t)lengths->number, n);
+        return;
+    }
+    entry *n_blocks = bk_config_lookup(ld, "model", "n_blocks");
+    if (n_blocks && n_blocks->number != 1.0)
+        bk_config_report_entry(ld, n_blocks, "a prescribed scene has one block, got %s", n_blocks->value);
+    bk_prescribed *pr = calloc(1, sizeof *pr);
+    bk_model *m = bk_model_create(1);
+    if (pr) {
+        pr->slip_rate = calloc(n, sizeof *pr->slip_rate);
+        pr->duration = calloc(n, sizeof *pr->duration);
+    }
+    c->prescribed = pr;
+    c->model = m;
+    if (!pr || !pr->slip_rate || !pr->duration || !m) {
+        bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+        return;
+    }
+    pr->n_segments = n;
+    double total = 0.0, first_rate = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+        double rate = rates->list[k];
+        pr->slip_rate[k] = rate;
+        if (distances && rate == 0.0) {
+            bk_config_report_entry(ld, distances, "segment %zu is a hold (slip rate 0): give durations", k + 1);
+            return;
+        }
+        pr->duration[k] = durations ? durations->list[k] : distances->list[k] / rate;
+        total += pr->duration[k];
+        if (!isfinite(total)) {
+            bk_config_report_entry(ld, lengths, "segment %zu makes the schedule longer than any finite time "
+                                   "(allowed: a finite total duration)", k + 1);
+            return;
+        }
+        if (first_rate == 0.0)
+            first_rate = rate;
+    }
+    m->gravity = value_of(ld, "model", "gravity");
+    m->driver.velocity = first_rate;
+    bk_block *b = &m->blocks[0];
+    int given_mass, given_normal;
+    double mass = block_value(ld, 0, "mass", &given_mass);
+    b->mass = given_mass ? mass : 1.0;
+    b->normal_force = block_value(ld, 0, "normal_force", &given_normal);
+    if (!given_normal)
+        b->normal_force = given_mass ? b->mass * m->gravity : 1.0;
+    build_friction(ld, b, 0, first_rate);
+    bk_model_finalize(m);
+    entry *t_end = bk_config_lookup(ld, "run", "t_end");
+    c->t_end = total;
+    if (t_end && t_end->number <= total * (1 + 1e-12))
+        c->t_end = t_end->number;
+    else if (t_end)
+        bk_config_report_entry(ld, t_end, "must be <= the schedule's length (%.10g s), got %s", total, t_end->value);
+}
+
+/* The method fits the scene and takes the options given: method = exact solves only
+ * affine scenes, arkode_table needs a method with tables.  Said here, before any output. */
+static void check_method_fits(loader *ld, const bk_config *c)
+{
+    entry *method = bk_config_lookup(ld, "solver", "method");
+    entry *table = bk_config_lookup(ld, "solver", "arkode_table");
+    if (table && strcmp(table->value, "default") != 0 && ld->error_rank == LONG_MAX) {
+        const bk_solver_backend *b = bk_solver_backend_find(c->solver.method);
+        char message[768];
+        if (!b || !b->check_options)
+            bk_config_report_entry(ld, table, "applies to method arkode_erk or arkode_dirk, not %s", c->solver.method);
+        else if (b->check_options(&c->solver, message, sizeof message) != 0)
+            bk_config_report_entry(ld, table, "%s", message);
+    }
+    if (!method || strcmp(method->value, "exact") != 0 || !c->model || c->prescribed ||
+        ld->error_rank != LONG_MAX)
+        return;
+    size_t i = bk_model_first_non_affine_block(c->model);
+    if (i < c->model->n_blocks)
+        bk_config_report_entry(ld, method,
+                               "needs Coulomb friction (a constant sliding force, no friction state) on every "
+                               "block; block %zu uses law %s (allowed: auto, or an integrator such as gsl_rk8pd "
+                               "or cvode_bdf)",
+                               i, c->model->blocks[i].law->name);
+}
+
+static int has_section(loader *ld, const char *section)
+{
+    for (size_t i = 0; i < ld->n; ++i)
+        if (!ld->entries[i].superseded && strcmp(ld->entries[i].base, section) == 0)
+            return 1;
+    return 0;
+}
+
+/* Everything checked: build the config.  Reports missing and cross-key errors. */
+bk_config *bk_config_build(loader *ld)
+{
+    bk_config *c = calloc(1, sizeof *c);
+    if (!c)
+        return NULL;
+    c->t_end = NAN; /* unknown until read: no cross-check against it before then */
+    if (has_section(ld, "prescribed"))
+        build_prescribed(ld, c);
+    else
+        build_chain(ld, c);
+
+    bk_solver_options *s = &c->solver;
+    snprintf(s->method, sizeof s->method, "%s", bk_config_method_name((size_t)value_of(ld, "solver", "method")));
+    snprintf(s->linear_solver, sizeof s->linear_solver, "%s",
+             bk_config_linear_solver_names[(size_t)value_of(ld, "solver", "linear_solver")]);
+    s->rtol = value_of(ld, "solver", "rtol");
+    s->atol_x = value_of(ld, "solver", "atol_x");
+    s->atol_v = value_of(ld, "solver", "atol_v");
+    s->max_step = value_of(ld, "solver", "max_step");
+    s->max_steps = (long)value_of(ld, "solver", "max_steps");
+    s->detect_velocity_extrema = (int)value_of(ld, "solver", "detect_velocity_extrema");
+    s->max_transitions_per_instant = (long)value_of(ld, "solver", "max_transitions_per_instant");
+    s->instant_window = value_of(ld, "solver", "instant_window");
+    s->min_step = value_of(ld, "solver", "min_step");
+    snprintf(s->arkode_table, sizeof s->arkode_table, "%s",
+             bk_solver_arkode_table((size_t)value_of(ld, "solver", "arkode_table")));
+    check_method_fits(ld, c);
+    c->wall_time_limit = value_of(ld, "run", "wall_time_limit");
+
+    bk_output_options *o = &c->output;
+    entry *path = bk_config_lookup(ld, "output", "path");
+    o->path = path ? strdup(path->value) : default_output_path(ld->name);
+    if (!o->path)
+        bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+    entry *interval = bk_config_lookup(ld, "output", "interval");
+    o->interval = interval ? interval->number : c->t_end / 1000.0;
+    if (interval && isfinite(c->t_end) && interval->number > c->t_end)
+        bk_config_report_entry(ld, interval, "must be <= t_end (%g s), got %s", c->t_end, interval->value);
+    o->fields = (unsigned)value_of(ld, "output", "fields");
+    if (c->prescribed)
+        o->fields &= ~(unsigned)BK_FIELD_ENERGY; /* no dynamics, no energies */
+    o->transitions = (int)value_of(ld, "output", "transitions");
+    o->event_rows = (int)value_of(ld, "output", "event_rows");
+    o->checkpoint_interval = value_of(ld, "output", "checkpoint_interval");
+    entry *checkpoints = bk_config_lookup(ld, "output", "checkpoint_interval");
+    if (c->prescribed && checkpoints && o->checkpoint_interval > 0.0)
+        bk_config_report_entry(ld, checkpoints, "a prescribed scene has no dynamics to checkpoint (allowed: 0)");
+    o->max_rows = (long)value_of(ld, "output", "max_rows");
+    double samples = o->interval > 0.0 ? c->t_end / o->interval : 0.0;
+    if (samples > (double)o->max_rows) {
+        if (interval)
+            bk_config_report_entry(ld, interval, "gives %.3g rows over t_end = %g s, more than [output] max_rows = %ld "
+                                   "(allowed: >= %g s, or raise max_rows)", samples, c->t_end, o->max_rows,
+                                   c->t_end / (double)o->max_rows);
+        else
+            bk_config_report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [output] interval: the default t_end / 1000 gives "
+                             "more than [output] max_rows = %ld rows", ld->name, o->max_rows);
+    }
+    o->max_bytes = value_of(ld, "output", "max_bytes");
+    if (c->model && ld->error_rank == LONG_MAX) {
+        double per_row = bk_output_row_bytes(o->fields, c->model->n_blocks, c->model->n_friction_state);
+        double bytes = (samples + 1.0) * per_row;
+        if (bytes > o->max_bytes) {
+            entry *at = interval ? interval : bk_config_lookup(ld, "output", "max_bytes");
+            if (!at)
+                at = bk_config_lookup(ld, "model", "n_blocks");
+            char where[512];
+            if (at)
+                bk_config_location(ld, at, where, sizeof where);
+            else
+                snprintf(where, sizeof where, "%s", ld->name);
+            bk_config_report(ld, at ? at->rank : RANK_MISSING, BK_ERR_CONFIG,
+                             "%s: [output] max_bytes: the sample rows would take about %.3g bytes (%.3g rows of %.3g "
+                             "bytes for %zu blocks), more than max_bytes = %.3g (allowed: a longer interval, fewer "
+                             "fields, or raise max_bytes)",
+                             where, bytes, samples + 1.0, per_row, c->model->n_blocks, o->max_bytes);
+        }
+    }
+    return c;
+}

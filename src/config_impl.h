@@ -1,0 +1,94 @@
+/* Private to the config loader, shared by its four files: config_keys.c (the key table and
+ * the reference), config_parse.c (text to checked entries), config_build.c (entries to a
+ * bk_config, with the cross-key checks) and config.c (the public entry points).  Not
+ * installed: the public API is include/bksim/config.h. */
+#ifndef BKSIM_CONFIG_IMPL_H
+#define BKSIM_CONFIG_IMPL_H
+
+#include <limits.h>
+#include <stddef.h>
+
+#include "bksim/config.h"
+
+#define SECTION_LEN 64
+#define KEY_LEN 64
+
+/* --- the key table (config_keys.c) ------------------------------------------------------ */
+
+typedef struct key_def {
+    const char *section;
+    bk_param param;               /* key, unit, default, range, flags, doc */
+    bk_key_kind type;
+    const char *const *choices;   /* BK_KEY_CHOICE with fixed words */
+    const char *(*choice)(size_t); /* BK_KEY_CHOICE with registered names */
+    const char *default_text;     /* for the reference when the default is not a number */
+} key_def;
+
+extern const char *const bk_config_sections[];           /* NULL-terminated, in reference order */
+extern const char *const bk_config_linear_solver_names[]; /* [solver] linear_solver words */
+const char *bk_config_method_name(size_t i);              /* [solver] method words; NULL past the end */
+const key_def *bk_config_find_key(const char *section, const char *key);
+const char *bk_config_enum_choice(const key_def *def, size_t i);
+void bk_config_list_keys(const char *section, char *buf, size_t len);
+void bk_config_format_allowed(const key_def *def, const bk_param *param, char *buf, size_t len);
+
+/* --- collected entries (config_parse.c) ------------------------------------------------- */
+
+typedef struct entry {
+    char section[SECTION_LEN]; /* as written, e.g. "block.3" */
+    char base[SECTION_LEN];    /* "block" */
+    long index;                /* block index of a per-block section, -1 otherwise */
+    char key[KEY_LEN];
+    char *value;
+    int line;                  /* file line, or 0 for an override */
+    int section_line;          /* line of the section's header (0: none, or an override) */
+    const char *override;      /* the --set text, or NULL */
+    long rank;                 /* position for "first error" */
+    int superseded;            /* replaced by a later override */
+    long first_of_key;         /* an earlier file entry of the same section and key, or -1 */
+    double number;             /* parsed value (numbers, bools, enum index, list length) */
+    double *list;              /* BK_KEY_LIST values, owned */
+} entry;
+
+typedef struct loader {
+    const char *name;          /* config file name for messages */
+    entry *entries;
+    size_t n, cap;
+    long error_rank;           /* rank of the recorded error, LONG_MAX when none */
+    bk_error *err;
+    int status;
+    /* reader state */
+    const char *cursor;
+    int line;
+    int section_line;          /* line of the last [section] header read */
+    int oom;
+    /* (section, key) -> the last live entry, so that lookups (per block, per key) cost O(1)
+     * and a config with many [block.I] sections loads in linear time. */
+    size_t *slots;             /* entry index + 1, 0 for an empty slot */
+    size_t n_slots;            /* a power of two, at least twice the entries */
+} loader;
+
+/* Ranks put errors in the order a user fixes them: 0 (out of memory) first, then file lines,
+ * then the --set overrides (INT_MAX + k), then keys that are missing altogether. */
+#define RANK_MISSING (LONG_MAX - 1)
+
+void bk_config_report(loader *ld, long rank, int status, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+void bk_config_report_entry(loader *ld, const entry *e, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+void bk_config_location(const loader *ld, const entry *e, char *buf, size_t len);
+int bk_config_add_entry(loader *ld, const char *section, const char *key, const char *value, int line,
+                        const char *override, long rank);
+/* inih's reader and handler (ini_parse_stream(bk_config_read_line, ld, bk_config_on_pair, ld)). */
+char *bk_config_read_line(char *str, int num, void *stream);
+int bk_config_on_pair(void *user, const char *section, const char *key, const char *value);
+int bk_config_build_index(loader *ld);
+entry *bk_config_lookup(loader *ld, const char *section, const char *key);
+int bk_config_check_value(loader *ld, entry *e, const key_def *def, const bk_param *param);
+void bk_config_check_entries(loader *ld, long n_blocks);
+
+/* --- building (config_build.c) ---------------------------------------------------------- */
+
+bk_config *bk_config_build(loader *ld);
+
+#endif
