@@ -20,7 +20,8 @@ SAN      := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-r
 LIB_SRC  := $(wildcard src/*.c src/friction/*.c src/solver/*.c src/output/*.c)
 CLI_SRC  := $(wildcard src/cli/*.c)
 TEST_SRC := $(wildcard tests/test_*.c)
-TEST_SUPPORT := $(filter-out $(TEST_SRC),$(wildcard tests/*.c))
+# Helpers shared by the tests, written once and linked into every test program.
+TEST_SUPPORT := $(wildcard tests/support/*.c)
 
 # $(call objs,BUILD_DIR,SOURCES)
 objs = $(patsubst %.c,$(1)/%.o,$(2))
@@ -45,6 +46,8 @@ build/%.o: %.c
 build-asan/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(SAN) -O1 -MMD -MP -c -o $@ $<
+# Tests include their support headers by name ("recorder.h").
+build/tests/%.o build-asan/tests/%.o: CPPFLAGS += -Itests/support
 
 TESTS      := $(patsubst tests/%.c,build/tests/%,$(TEST_SRC))
 TESTS_ASAN := $(patsubst tests/%.c,build-asan/tests/%,$(TEST_SRC))
@@ -72,7 +75,8 @@ test-valgrind: bksim $(TESTS)
 
 # Static analysis; options and suppressions are committed in tests/cppcheck.cfg.
 lint:
-	cppcheck $$(cat tests/cppcheck.cfg) -Iinclude -Isrc src tests/*.c tests/fuzz/*.c bench/*.c
+	cppcheck $$(cat tests/cppcheck.cfg) -Iinclude -Isrc -Itests/support src tests/*.c tests/support/*.c \
+	    tests/fuzz/*.c bench/*.c
 
 paper: bksim
 	scripts/run_paper.sh
