@@ -20,7 +20,8 @@ SAN      := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-r
 LIB_SRC  := $(wildcard src/*.c src/friction/*.c src/solver/*.c src/output/*.c)
 CLI_SRC  := $(wildcard src/cli/*.c)
 TEST_SRC := $(wildcard tests/test_*.c)
-TEST_SUPPORT := $(filter-out $(TEST_SRC),$(wildcard tests/*.c))
+# Helpers shared by the tests, written once and linked into every test program.
+TEST_SUPPORT := $(wildcard tests/support/*.c)
 
 # $(call objs,BUILD_DIR,SOURCES)
 objs = $(patsubst %.c,$(1)/%.o,$(2))
@@ -47,6 +48,8 @@ build/%.o: %.c
 build-asan/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(SAN) -O1 -MMD -MP -c -o $@ $<
+# Tests include their support headers by name ("recorder.h").
+build/tests/%.o build-asan/tests/%.o: CPPFLAGS += -Itests/support
 
 TESTS      := $(patsubst tests/%.c,build/tests/%,$(TEST_SRC))
 TESTS_ASAN := $(patsubst tests/%.c,build-asan/tests/%,$(TEST_SRC))
@@ -75,7 +78,8 @@ test-valgrind: bksim $(TESTS)
 # Static analysis (options and suppressions in tests/cppcheck.cfg), then the library's
 # namespace: every symbol libbksim.a exports starts with bk_.
 lint: build/libbksim.a
-	cppcheck $$(cat tests/cppcheck.cfg) -Iinclude -Isrc src tests/*.c tests/fuzz/*.c bench/*.c
+	cppcheck $$(cat tests/cppcheck.cfg) -Iinclude -Isrc -Itests/support src tests/*.c tests/support/*.c \
+	    tests/fuzz/*.c bench/*.c
 	@bad=$$(nm -g --defined-only build/libbksim.a | awk 'NF == 3 && $$3 !~ /^bk_/ {print $$3}'); \
 	 if [ -n "$$bad" ]; then echo "lint: symbols of libbksim.a without the bk_ prefix:" $$bad >&2; exit 1; fi; \
 	 echo "lint: every exported symbol of libbksim.a starts with bk_"

@@ -11,6 +11,8 @@
 #include "bk_test.h"
 #include "bksim/bksim.h"
 #include "exact_single.h"
+#include "recorder.h"
+#include "scene_spec.h"
 
 /* Cases A and B: every transition time within TIME_FACTOR * rtol of the closed form,
  * relative.  Measured worst over all back-ends: 12 rtol (cvode_bdf, case B, rtol 1e-10);
@@ -19,110 +21,10 @@
 /* 10-block chain: |energy residual| <= ENERGY_FACTOR * rtol (measured worst: 0.4 rtol). */
 #define ENERGY_FACTOR 100.0
 
-/* --- a memory sink (as tests/test_run.c) ----------------------------------------------- */
-
-typedef struct recorder {
-    bk_transition *transitions;
-    size_t n_transitions, cap_transitions;
-    size_t rows;
-    double last_t;
-    int time_decreased;
-} recorder;
-
-static int record_sample(void *self, const bk_sample *s, bk_error *err)
-{
-    (void)err;
-    recorder *r = self;
-    if (r->rows > 0 && !(s->t > r->last_t))
-        r->time_decreased = 1;
-    r->last_t = s->t;
-    r->rows++;
-    return BK_OK;
-}
-
-static int record_transition(void *self, const bk_transition *t, bk_error *err)
-{
-    (void)err;
-    recorder *r = self;
-    if (r->n_transitions == r->cap_transitions) {
-        size_t cap = r->cap_transitions ? 2 * r->cap_transitions : 64;
-        bk_transition *grown = realloc(r->transitions, cap * sizeof *grown);
-        if (!grown)
-            return BK_ERR_NOMEM;
-        r->transitions = grown;
-        r->cap_transitions = cap;
-    }
-    r->transitions[r->n_transitions++] = *t;
-    return BK_OK;
-}
-
-static void recorder_free(recorder *r) { free(r->transitions); }
-
-/* --- scenes built in code (as tests/test_run.c) ---------------------------------------- */
-
-typedef struct scene_spec {
-    size_t n;
-    double mass, stiffness, coupling, mu_s, mu_d, velocity, t_end, rtol, interval;
-    bk_spring spring;
-    const char *method;
-} scene_spec;
-
-static scene_spec paper_case(double mu_d, bk_spring spring, double rtol, const char *method)
-{
-    return (scene_spec){.n = 1, .mass = 1.0, .stiffness = 1e4, .coupling = 0.0, .mu_s = 0.6,
-                        .mu_d = mu_d, .velocity = 1e-3, .t_end = 5.0, .rtol = rtol,
-                        .interval = 1e-3, .spring = spring, .method = method};
-}
-
-static bk_config *make_config(const scene_spec *spec)
-{
-    bk_config *c = calloc(1, sizeof *c);
-    assert_non_null(c);
-    bk_model *m = bk_model_create(spec->n);
-    assert_non_null(m);
-    m->boundary = BK_BOUNDARY_FREE;
-    m->coupling_stiffness = spec->coupling;
-    m->gravity = 9.81;
-    m->spring = spec->spring;
-    m->driver.velocity = spec->velocity;
-    for (size_t i = 0; i < spec->n; ++i) {
-        bk_block *b = &m->blocks[i];
-        b->mass = spec->mass;
-        b->driver_stiffness = spec->stiffness;
-        b->normal_force = spec->mass * 9.81;
-        b->law = &bk_friction_coulomb;
-        b->friction_params[0] = spec->mu_s;
-        b->friction_params[1] = spec->mu_d;
-    }
-    bk_model_finalize(m);
-    c->model = m;
-    c->t_end = spec->t_end;
-    snprintf(c->solver.method, sizeof c->solver.method, "%s", spec->method);
-    snprintf(c->solver.linear_solver, sizeof c->solver.linear_solver, "auto");
-    c->solver.rtol = spec->rtol;
-    c->solver.atol_x = c->solver.atol_v = c->solver.max_step = NAN;
-    c->solver.max_steps = 1000000;
-    c->solver.detect_velocity_extrema = 1;
-    c->solver.max_transitions_per_instant = 100;
-    c->solver.instant_window = NAN;
-    c->output.interval = spec->interval;
-    c->output.fields = BK_FIELD_ALL;
-    c->output.transitions = 1;
-    c->output.event_rows = 1;
-    return c;
-}
-
-static void free_config(bk_config *c)
-{
-    bk_model_free(c->model);
-    free(c);
-}
-
 static void run_config(bk_config *c, recorder *r, bk_run_stats *stats)
 {
-    bk_sink sink = {.self = r, .sample = record_sample, .transition = record_transition};
     bk_error err = {0};
-    int rc = bk_run(c, &sink, stats, NULL, NULL, &err);
+    int rc = run_recorded(c, r, stats, &err);
     if (rc != BK_OK)
         print_error("%s: %s\n", c->solver.method, err.message);
     assert_int_equal(rc, BK_OK);
@@ -149,7 +51,7 @@ static double transition_error(const char *method, double mu_d, bk_spring spring
                                const exact_solution *ex, const char *label)
 {
     scene_spec spec = paper_case(mu_d, spring, rtol, method);
-    bk_config *c = make_config(&spec);
+    bk_config *c = scene_config(&spec);
     recorder r = {0};
     bk_run_stats stats;
     run_config(c, &r, &stats);
@@ -168,7 +70,7 @@ static double transition_error(const char *method, double mu_d, bk_spring spring
     row(method, label, rtol, &stats, "dt/t", worst);
     assert_true(worst <= TIME_FACTOR * rtol);
     recorder_free(&r);
-    free_config(c);
+    bk_config_free(c);
     return worst;
 }
 
@@ -211,7 +113,7 @@ static void test_case_c(void **state)
     header();
     for (const bk_solver_backend *const *b = bk_solver_backends(); *b; ++b) {
         scene_spec spec = paper_case(0.5999, BK_SPRING_LINEAR, 1e-8, (*b)->name);
-        bk_config *c = make_config(&spec);
+        bk_config *c = scene_config(&spec);
         recorder r = {0};
         bk_run_stats stats;
         run_config(c, &r, &stats);
@@ -226,7 +128,7 @@ static void test_case_c(void **state)
          * allow 1e3 rtol V / a = 1.0e-5 s (measured worst 5e-7 s, cvode_bdf). */
         assert_true(worst < 1e3 * spec.rtol * spec.velocity / ((0.6 - 0.5999) * 9.81));
         recorder_free(&r);
-        free_config(c);
+        bk_config_free(c);
     }
     exact_free(&ex);
 }
@@ -244,7 +146,7 @@ static void chain_energy(const char *method, const char *linear_solver)
         spec.n = 10;
         spec.coupling = 2e4;
         spec.t_end = 3.0;
-        bk_config *c = make_config(&spec);
+        bk_config *c = scene_config(&spec);
         snprintf(c->solver.linear_solver, sizeof c->solver.linear_solver, "%s", linear_solver);
         for (size_t i = 0; i < spec.n; ++i) {
             c->model->blocks[i].x_init = 1e-5 * sin(2.385 * (double)i);
@@ -259,7 +161,7 @@ static void chain_energy(const char *method, const char *linear_solver)
         assert_true(stats.work_driver > 0.0);
         assert_true(fabs(stats.energy_residual) <= ENERGY_FACTOR * rtol);
         recorder_free(&r);
-        free_config(c);
+        bk_config_free(c);
     }
 }
 
@@ -293,7 +195,7 @@ static void test_arkode_tables(void **state)
                                  : "arkode_dirk";
         assert_int_equal(bk_solver_backend_find(method)->check_options(&options, message, sizeof message), 0);
         scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, 1e-7, method);
-        bk_config *c = make_config(&spec);
+        bk_config *c = scene_config(&spec);
         c->solver.arkode_table[0] = '\0';
         strncat(c->solver.arkode_table, name, sizeof c->solver.arkode_table - 1);
         recorder r = {0};
@@ -306,7 +208,7 @@ static void test_arkode_tables(void **state)
         print_message("%-12s %-30s %7ld %8ld  dt/t %.2e\n", method, name, stats.steps, stats.rhs_evals, worst);
         assert_true(worst <= TIME_FACTOR * spec.rtol);
         recorder_free(&r);
-        free_config(c);
+        bk_config_free(c);
     }
     assert_int_equal(tables, 14 + 23);
     exact_free(&ex);

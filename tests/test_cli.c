@@ -5,15 +5,15 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <hdf5.h>
 
 #include "bk_test.h"
 #include "bksim/bksim.h"
+#include "command.h"
 #include "exact_single.h"
+#include "files.h"
 #include "same_output.h"
 
 static char tmpdir[256];
@@ -21,71 +21,13 @@ static char tmpdir[256];
 static int setup(void **state)
 {
     (void)state;
-    snprintf(tmpdir, sizeof tmpdir, "/tmp/bksim_cli_XXXXXX");
-    return mkdtemp(tmpdir) ? 0 : -1;
+    return make_temp_dir(tmpdir, sizeof tmpdir, "bksim_cli");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    char cmd[512];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-    return system(cmd) == 0 ? 0 : -1;
-}
-
-/* The binary under test: $BKSIM (make test-asan sets the sanitizer build), else ./bksim. */
-static const char *bksim_binary(void)
-{
-    const char *bin = getenv("BKSIM");
-    return bin && *bin ? bin : "./bksim";
-}
-
-/* Run a shell command, with "./bksim" standing for the binary under test; return its exit
- * status, with stdout+stderr in *output (malloc'ed). */
-static int run(const char *command, char **output)
-{
-    char replaced[4096], full[4200];
-    const char *bin = bksim_binary();
-    size_t used = 0;
-    for (const char *c = command; *c && used + 1 < sizeof replaced;) {
-        if (strncmp(c, "./bksim", 7) == 0 && (c[7] == ' ' || c[7] == '\0')) {
-            used += (size_t)snprintf(replaced + used, sizeof replaced - used, "%s", bin);
-            c += 7;
-        } else {
-            replaced[used++] = *c++;
-        }
-    }
-    assert_true(used + 1 < sizeof replaced);
-    replaced[used] = '\0';
-    snprintf(full, sizeof full, "{ %s; } 2>&1", replaced);
-    FILE *p = popen(full, "r");
-    assert_non_null(p);
-    size_t cap = 4096, len = 0;
-    char *buf = malloc(cap);
-    assert_non_null(buf);
-    size_t got;
-    while ((got = fread(buf + len, 1, cap - len - 1, p)) > 0) {
-        len += got;
-        if (cap - len < 2) {
-            cap *= 2;
-            char *grown = realloc(buf, cap);
-            assert_non_null(grown);
-            buf = grown;
-        }
-    }
-    buf[len] = '\0';
-    int status = pclose(p);
-    if (output)
-        *output = buf;
-    else
-        free(buf);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-static int exists(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0;
+    return remove_tree(tmpdir);
 }
 
 /* --- the paper's configs --------------------------------------------------------------- */
@@ -96,12 +38,12 @@ static void check_paper_case(const char *stem, double mu_d, int tension_only)
     snprintf(out, sizeof out, "%s/%s.h5", tmpdir, stem);
     snprintf(cmd, sizeof cmd, "./bksim run configs/paper/%s.ini -o %s --quiet", stem, out);
     char *text = NULL;
-    int status = run(cmd, &text);
+    int status = run_command(cmd, &text);
     if (status != 0)
         print_error("%s\n", text);
     free(text);
     assert_int_equal(status, 0);
-    assert_true(exists(out));
+    assert_true(path_exists(out));
 
     bk_transition *rows = NULL;
     size_t n = 0;
@@ -165,7 +107,7 @@ static slip_summary summarise(const char *stem)
     char out[512], cmd[1024];
     snprintf(out, sizeof out, "%s/%s.h5", tmpdir, stem);
     snprintf(cmd, sizeof cmd, "./bksim run configs/paper/%s.ini -o %s --quiet", stem, out);
-    assert_int_equal(run(cmd, NULL), 0);
+    assert_int_equal(run_command(cmd, NULL), 0);
     bk_transition *tr = NULL;
     size_t n = 0;
     bk_error err = {0};
@@ -270,34 +212,34 @@ static void test_bad_inputs(void **state)
         write_config(path, cases[k].line, cases[k].replacement);
         snprintf(cmd, sizeof cmd, "cd %s && %s/%s run bad.ini -o %s", tmpdir, cwd, bksim_binary(), out);
         char *text = NULL;
-        int status = run(cmd, &text);
+        int status = run_command(cmd, &text);
         if (status != 2 || !strstr(text, cases[k].expect))
             print_error("case %zu: status %d, output:\n%s\nexpected: %s\n", k, status, text,
                         cases[k].expect);
         assert_int_equal(status, 2);
         assert_non_null(strstr(text, cases[k].expect));
-        assert_false(exists(out));
+        assert_false(path_exists(out));
         char part[600];
         snprintf(part, sizeof part, "%s.part", out);
-        assert_false(exists(part));
+        assert_false(path_exists(part));
         free(text);
         /* check says the same */
         snprintf(cmd, sizeof cmd, "cd %s && %s/%s check bad.ini", tmpdir, cwd, bksim_binary());
-        assert_int_equal(run(cmd, NULL), 2);
+        assert_int_equal(run_command(cmd, NULL), 2);
     }
     /* An unreadable config: I/O failure, exit 1, nothing written. */
     snprintf(cmd, sizeof cmd, "./bksim run %s/missing.ini -o %s", tmpdir, out);
     char *text = NULL;
-    assert_int_equal(run(cmd, &text), 1);
+    assert_int_equal(run_command(cmd, &text), 1);
     assert_non_null(strstr(text, "missing.ini"));
-    assert_false(exists(out));
+    assert_false(path_exists(out));
     free(text);
     /* A bad --set names itself as the location. */
     write_config(path, NULL, NULL);
     snprintf(cmd, sizeof cmd, "./bksim run %s --set block.mass=0 -o %s", path, out);
-    assert_int_equal(run(cmd, &text), 2);
+    assert_int_equal(run_command(cmd, &text), 2);
     assert_non_null(strstr(text, "--set block.mass=0: [block] mass:"));
-    assert_false(exists(out));
+    assert_false(path_exists(out));
     free(text);
 }
 
@@ -469,11 +411,11 @@ static long check_key(const char *law, int prescribed, const char *section, bk_k
         /* The CLI: exit status 2, the same message, and no file. */
         snprintf(cmd, sizeof cmd, "./bksim run %s -o %s", path, out);
         char *text = NULL;
-        assert_int_equal(run(cmd, &text), 2);
+        assert_int_equal(run_command(cmd, &text), 2);
         assert_non_null(strstr(text, full));
         free(text);
-        assert_false(exists(out));
-        assert_false(exists(part));
+        assert_false(path_exists(out));
+        assert_false(path_exists(part));
         ++rejected;
     }
     return rejected;
@@ -505,14 +447,14 @@ static void test_commands(void **state)
     write_config(path, NULL, NULL);
 
     snprintf(cmd, sizeof cmd, "./bksim check %s", path);
-    assert_int_equal(run(cmd, &text), 0);
+    assert_int_equal(run_command(cmd, &text), 0);
     assert_non_null(strstr(text, "ok"));
     free(text);
 
     /* --set changes the run: a shorter t_end. */
     snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --set run.t_end=0.65 --quiet", path, out);
-    assert_int_equal(run(cmd, NULL), 0);
-    assert_true(exists(out));
+    assert_int_equal(run_command(cmd, NULL), 0);
+    assert_true(path_exists(out));
     double *time = NULL;
     size_t rows, cols;
     bk_error err = {0};
@@ -521,38 +463,38 @@ static void test_commands(void **state)
     free(time);
 
     snprintf(cmd, sizeof cmd, "./bksim info %s", out);
-    assert_int_equal(run(cmd, &text), 0);
+    assert_int_equal(run_command(cmd, &text), 0);
     assert_non_null(strstr(text, "t_end"));
     assert_non_null(strstr(text, "--set run.t_end=0.65")); /* the config as run */
     free(text);
 
     snprintf(cmd, sizeof cmd, "./bksim export %s --datasets time,x,v --block 0", out);
-    assert_int_equal(run(cmd, &text), 0);
+    assert_int_equal(run_command(cmd, &text), 0);
     assert_true(text[0] == '#');
     free(text);
     snprintf(cmd, sizeof cmd, "./bksim export %s --transitions", out);
-    assert_int_equal(run(cmd, &text), 0);
+    assert_int_equal(run_command(cmd, &text), 0);
     assert_non_null(strstr(text, "0.5886"));
     free(text);
     snprintf(cmd, sizeof cmd, "./bksim export %s --block 7", out);
-    assert_int_equal(run(cmd, NULL), 1);
+    assert_int_equal(run_command(cmd, NULL), 1);
     snprintf(cmd, sizeof cmd, "./bksim info %s/nothing.h5", tmpdir);
-    assert_int_equal(run(cmd, NULL), 1);
+    assert_int_equal(run_command(cmd, NULL), 1);
 
     const char *helps[] = {"run", "check", "info", "export", "keys"};
     for (size_t k = 0; k < 5; ++k) {
         snprintf(cmd, sizeof cmd, "./bksim %s --help", helps[k]);
-        assert_int_equal(run(cmd, &text), 0);
+        assert_int_equal(run_command(cmd, &text), 0);
         assert_non_null(strstr(text, "usage: bksim"));
         free(text);
     }
-    assert_int_equal(run("./bksim frobnicate", NULL), 2);
-    assert_int_equal(run("./bksim", NULL), 2);
-    assert_int_equal(run("./bksim run", NULL), 2);
-    assert_int_equal(run("./bksim --version", &text), 0);
+    assert_int_equal(run_command("./bksim frobnicate", NULL), 2);
+    assert_int_equal(run_command("./bksim", NULL), 2);
+    assert_int_equal(run_command("./bksim run", NULL), 2);
+    assert_int_equal(run_command("./bksim --version", &text), 0);
     assert_non_null(strstr(text, BKSIM_VERSION));
     free(text);
-    assert_int_equal(run("./bksim keys", &text), 0);
+    assert_int_equal(run_command("./bksim keys", &text), 0);
     assert_non_null(strstr(text, "mu_d"));
     free(text);
 }
@@ -566,7 +508,7 @@ static int run_and_signal(const char *out, const char *signal_name, char **text)
              "--set run.t_end=100000 --set output.interval=1e-3 & pid=$!; sleep 1; "
              "kill -%s $pid; wait $pid",
              out, signal_name);
-    return run(cmd, text);
+    return run_command(cmd, text);
 }
 
 /* SIGTERM and SIGINT stop the run at the next step: the file stays "<out>.part", intact and
@@ -583,12 +525,12 @@ static void test_interrupted_run_is_marked(void **state)
         assert_int_equal(run_and_signal(out, signals[k], &text), 1);
         assert_non_null(strstr(text, "interrupted"));
         free(text);
-        assert_false(exists(out));
-        assert_true(exists(part));
+        assert_false(path_exists(out));
+        assert_true(path_exists(part));
         bk_error err = {0};
         assert_int_equal(bk_h5_verify(part, &err), BK_INCOMPLETE);
         snprintf(cmd, sizeof cmd, "./bksim info %s", part);
-        assert_int_equal(run(cmd, &text), 3);
+        assert_int_equal(run_command(cmd, &text), 3);
         assert_non_null(strstr(text, "complete     0 (run did not finish)"));
         assert_non_null(strstr(text, "error        run interrupted at t = "));
         free(text);
@@ -606,10 +548,10 @@ static void test_killed_run_leaves_partial(void **state)
     char *text = NULL;
     assert_int_equal(run_and_signal(out, "KILL", &text), 137);
     free(text);
-    assert_false(exists(out));
-    assert_true(exists(part));
+    assert_false(path_exists(out));
+    assert_true(path_exists(part));
     snprintf(cmd, sizeof cmd, "./bksim info %s", part);
-    int status = run(cmd, &text);
+    int status = run_command(cmd, &text);
     /* Readable (flushed chunk by chunk) and incomplete, or unreadable and said to be partial. */
     if (status == 3)
         assert_non_null(strstr(text, "did not finish"));
@@ -625,7 +567,7 @@ static void test_damaged_files(void **state)
     char good[512], cmd[2048];
     snprintf(good, sizeof good, "%s/intact.h5", tmpdir);
     snprintf(cmd, sizeof cmd, "./bksim run configs/paper/case_a_coulomb.ini -o %s --quiet", good);
-    assert_int_equal(run(cmd, NULL), 0);
+    assert_int_equal(run_command(cmd, NULL), 0);
     bk_error err = {0};
     assert_int_equal(bk_h5_verify(good, &err), BK_OK);
     char *text = NULL;
@@ -633,9 +575,9 @@ static void test_damaged_files(void **state)
     /* Truncated to half its size. */
     snprintf(cmd, sizeof cmd, "cp %s %s/truncated.h5 && truncate -s $(( $(stat -c %%s %s) / 2 )) %s/truncated.h5",
              good, tmpdir, good, tmpdir);
-    assert_int_equal(run(cmd, NULL), 0);
+    assert_int_equal(run_command(cmd, NULL), 0);
     snprintf(cmd, sizeof cmd, "./bksim info %s/truncated.h5", tmpdir);
-    assert_int_equal(run(cmd, &text), 1);
+    assert_int_equal(run_command(cmd, &text), 1);
     free(text);
 
     /* Hand-corrupted: a time series shortened, and time made non-monotonic (h5 tools would do
@@ -643,7 +585,7 @@ static void test_damaged_files(void **state)
     char edited[512];
     snprintf(edited, sizeof edited, "%s/edited.h5", tmpdir);
     snprintf(cmd, sizeof cmd, "cp %s %s", good, edited);
-    assert_int_equal(run(cmd, NULL), 0);
+    assert_int_equal(run_command(cmd, NULL), 0);
     hid_t file = H5Fopen(edited, H5F_ACC_RDWR, H5P_DEFAULT);
     assert_true(file >= 0);
     hid_t time = H5Dopen2(file, "time", H5P_DEFAULT);
@@ -659,12 +601,12 @@ static void test_damaged_files(void **state)
     assert_int_equal(bk_h5_verify(edited, &err), BK_ERR_DAMAGED);
     assert_non_null(strstr(err.message, "/time is not strictly increasing at row 1000"));
     snprintf(cmd, sizeof cmd, "./bksim info %s", edited);
-    assert_int_equal(run(cmd, &text), 1);
+    assert_int_equal(run_command(cmd, &text), 1);
     assert_non_null(strstr(text, "DAMAGED"));
     free(text);
 
     snprintf(cmd, sizeof cmd, "cp %s %s", good, edited);
-    assert_int_equal(run(cmd, NULL), 0);
+    assert_int_equal(run_command(cmd, NULL), 0);
     file = H5Fopen(edited, H5F_ACC_RDWR, H5P_DEFAULT);
     hid_t v = H5Dopen2(file, "v", H5P_DEFAULT);
     hsize_t dims[2] = {100, 1};
@@ -696,13 +638,13 @@ static void test_limits(void **state)
         snprintf(part, sizeof part, "%s.part", out);
         snprintf(cmd, sizeof cmd, "./bksim run configs/paper/case_a_coulomb.ini -o %s -q %s", out, cases[k].sets);
         char *text = NULL;
-        int status = run(cmd, &text);
+        int status = run_command(cmd, &text);
         if (status != 1 || !strstr(text, cases[k].message))
             print_error("case %zu: status %d\n%s\nexpected: %s\n", k, status, text, cases[k].message);
         assert_int_equal(status, 1);
         assert_non_null(strstr(text, cases[k].message));
         free(text);
-        assert_false(exists(out));
+        assert_false(path_exists(out));
         bk_error err = {0};
         assert_int_equal(bk_h5_verify(part, &err), BK_INCOMPLETE);
     }
@@ -722,22 +664,22 @@ static void test_restart_equivalence(void **state)
         snprintf(part, sizeof part, "%s.part", stopped);
         const char *common = "configs/paper/case_b_coulomb.ini --quiet --set output.checkpoint_interval=0.1";
         snprintf(cmd, sizeof cmd, "./bksim run %s --set solver.method=%s -o %s", common, methods[m], reference);
-        assert_int_equal(run(cmd, NULL), 0);
+        assert_int_equal(run_command(cmd, NULL), 0);
         /* The same run under a wall-clock limit so short that it stops many times (each
          * invocation still passes a checkpoint, or it could not progress). */
         snprintf(cmd, sizeof cmd, "./bksim run %s --set solver.method=%s --set run.wall_time_limit=0.02 -o %s",
                  common, methods[m], stopped);
-        int status = run(cmd, NULL);
+        int status = run_command(cmd, NULL);
         int restarts = 0;
         while (status == 1 && restarts < 500) {
             snprintf(cmd, sizeof cmd, "./bksim run --restart %s --quiet", part);
-            status = run(cmd, NULL);
+            status = run_command(cmd, NULL);
             ++restarts;
         }
         print_message("%s: finished after %d restarts\n", methods[m], restarts);
         assert_int_equal(status, 0);
         assert_true(restarts >= 1);
-        assert_false(exists(part));
+        assert_false(path_exists(part));
         assert_same_output(reference, stopped);
         bk_error err = {0};
         assert_int_equal(bk_h5_verify(stopped, &err), BK_OK);
@@ -761,7 +703,7 @@ static void test_sigkill_restart_loop(void **state)
     snprintf(cmd, sizeof cmd, "s=$(date +%%s%%N); ./bksim run %s -o %s && echo $(( $(date +%%s%%N) - s ))",
              common, reference);
     char *text = NULL;
-    assert_int_equal(run(cmd, &text), 0);
+    assert_int_equal(run_command(cmd, &text), 0);
     double wall = strtod(text, NULL) * 1e-9;
     free(text);
     assert_true(wall > 0.0);
@@ -784,7 +726,7 @@ static void test_sigkill_restart_loop(void **state)
                          "kill -9 $pid 2>/dev/null; wait $pid", out, common, out, delay);
             restarts += have_part;
             int was_restart = have_part;
-            status = run(cmd, &text);
+            status = run_command(cmd, &text);
             finished_by_restart += status == 0 && was_restart;
             if (status == 137) {
                 ++kills;
@@ -800,7 +742,7 @@ static void test_sigkill_restart_loop(void **state)
             free(text);
         }
         assert_int_equal(status, 0);
-        assert_true(exists(out));
+        assert_true(path_exists(out));
         assert_same_output(reference, out);
         bk_error err = {0};
         assert_int_equal(bk_h5_verify(out, &err), BK_OK);
@@ -820,22 +762,22 @@ static void test_restart_errors(void **state)
     snprintf(out, sizeof out, "%s/no_checkpoint.h5", tmpdir);
     snprintf(cmd, sizeof cmd,
              "./bksim run configs/paper/case_b_coulomb.ini -o %s -q --set run.wall_time_limit=1e-4", out);
-    assert_int_equal(run(cmd, NULL), 1);
+    assert_int_equal(run_command(cmd, NULL), 1);
     snprintf(cmd, sizeof cmd, "./bksim run --restart %s.part", out);
-    assert_int_equal(run(cmd, &text), 2);
+    assert_int_equal(run_command(cmd, &text), 2);
     assert_non_null(strstr(text, "no checkpoint to restart from (run with [output] checkpoint_interval > 0)"));
     free(text);
     snprintf(cmd, sizeof cmd, "./bksim run configs/paper/case_a_coulomb.ini -q -o %s/finished.h5 "
                               "--set output.checkpoint_interval=1 && ./bksim run --restart %s/finished.h5",
              tmpdir, tmpdir);
-    assert_int_equal(run(cmd, &text), 2);
+    assert_int_equal(run_command(cmd, &text), 2);
     assert_non_null(strstr(text, "the run is complete, nothing to restart"));
     free(text);
     snprintf(cmd, sizeof cmd, "./bksim run --restart %s/nothing.h5", tmpdir);
-    assert_int_equal(run(cmd, &text), 2);
+    assert_int_equal(run_command(cmd, &text), 2);
     assert_non_null(strstr(text, "no such file to restart from"));
     free(text);
-    assert_int_equal(run("./bksim run configs/paper/case_b_coulomb.ini --restart x.h5", &text), 2);
+    assert_int_equal(run_command("./bksim run configs/paper/case_b_coulomb.ini --restart x.h5", &text), 2);
     assert_non_null(strstr(text, "--restart takes no CONFIG"));
     free(text);
     /* Running the same command again does not throw a restartable run's progress away. */
@@ -843,7 +785,7 @@ static void test_restart_errors(void **state)
 #define STOPPED_RUN "./bksim run configs/paper/case_b_coulomb.ini -q -o %s --set solver.method=cvode_bdf " \
                     "--set output.checkpoint_interval=0.01 --set run.wall_time_limit=%s"
     snprintf(cmd, sizeof cmd, STOPPED_RUN, out, "0.01");
-    assert_int_equal(run(cmd, NULL), 1);
+    assert_int_equal(run_command(cmd, NULL), 1);
     char part[600];
     snprintf(part, sizeof part, "%s.part", out);
     double t_checkpoint = 0.0;
@@ -851,7 +793,7 @@ static void test_restart_errors(void **state)
     assert_int_equal(bk_h5_restartable(out, &t_checkpoint, &err), 1);
     snprintf(cmd, sizeof cmd, STOPPED_RUN, out, "0");
 #undef STOPPED_RUN
-    assert_int_equal(run(cmd, &text), 2);
+    assert_int_equal(run_command(cmd, &text), 2);
     assert_non_null(strstr(text, "holds a run stopped at its checkpoint"));
     assert_non_null(strstr(text, "--force to start over"));
     free(text);
@@ -859,8 +801,8 @@ static void test_restart_errors(void **state)
     assert_int_equal(bk_h5_restartable(out, &t_again, &err), 1);
     assert_true(t_again == t_checkpoint);
     strncat(cmd, " --force", sizeof cmd - strlen(cmd) - 1);
-    assert_int_equal(run(cmd, NULL), 0);
-    assert_true(exists(out) && !exists(part));
+    assert_int_equal(run_command(cmd, NULL), 0);
+    assert_true(path_exists(out) && !path_exists(part));
 }
 
 /* The benchmark's smoke run: every back-end on case B at three tolerances, all succeed
@@ -870,7 +812,7 @@ static void test_bench_smoke(void **state)
 {
     (void)state;
     char *text = NULL;
-    assert_int_equal(run("build/bench/bksim_bench --quick --repeats 1 --case B_coulomb", &text), 0);
+    assert_int_equal(run_command("build/bench/bksim_bench --quick --repeats 1 --case B_coulomb", &text), 0);
     char method[64] = "", last_method[64] = "";
     double last_error = 0.0;
     int rows = 0;
@@ -892,9 +834,9 @@ static void test_bench_smoke(void **state)
     }
     free(text);
     assert_true(rows >= 20);
-    if (run("command -v gnuplot", NULL) != 0)
+    if (run_command("command -v gnuplot", NULL) != 0)
         return; /* the plots need gnuplot (quickstart.sh installs it) */
-    assert_int_equal(run("scripts/bench.sh --quick", &text), 0);
+    assert_int_equal(run_command("scripts/bench.sh --quick", &text), 0);
     char dir[512] = "";
     const char *at = strstr(text, "benchmark written to ");
     assert_non_null(at);
@@ -905,11 +847,11 @@ static void test_bench_smoke(void **state)
     for (size_t k = 0; k < sizeof files / sizeof files[0]; ++k) {
         char path[600];
         snprintf(path, sizeof path, "%s/%s", dir, files[k]);
-        assert_true(exists(path));
+        assert_true(path_exists(path));
     }
     char cmd[600];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    assert_int_equal(run(cmd, NULL), 0);
+    assert_int_equal(run_command(cmd, NULL), 0);
 }
 
 /* README's config reference is exactly what `bksim keys` prints. */
@@ -917,7 +859,7 @@ static void test_readme_reference_current(void **state)
 {
     (void)state;
     char *keys = NULL;
-    assert_int_equal(run("./bksim keys", &keys), 0);
+    assert_int_equal(run_command("./bksim keys", &keys), 0);
     FILE *f = fopen("README.md", "r");
     assert_non_null(f);
     char *readme = calloc(1, 1 << 20);

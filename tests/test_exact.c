@@ -1,6 +1,6 @@
 /* The exact piecewise-analytic stepper: its modal solution against independent closed forms,
- * the paper's single block (cases A, B, C, both springs) against tests/exact_single.c to
- * ~1e-12 (every transition, including case C's 0.2 ms sticks that integrators cannot
+ * the paper's single block (cases A, B, C, both springs) against tests/support/exact_single.c
+ * to ~1e-12 (every transition, including case C's 0.2 ms sticks that integrators cannot
  * resolve), 10-block chains against CVODE Adams at rtol 1e-12, refusal of non-affine
  * problems with a clear message, and its speed next to CVODE (reported, not asserted). */
 #include <float.h>
@@ -11,126 +11,10 @@
 #include "bk_test.h"
 #include "bksim/bksim.h"
 #include "exact_single.h"
+#include "recorder.h"
+#include "scene_spec.h"
 
 #define PI 3.14159265358979323846
-
-/* --- a memory sink (as in test_run.c) -------------------------------------------------- */
-
-typedef struct recorder {
-    bk_transition *transitions;
-    size_t n_transitions, cap_transitions;
-    size_t rows;
-    double last_t;
-    int time_decreased;
-    double max_balance_error; /* |W - dE_el - dE_kin - D| over rows, J */
-    double max_work;          /* J */
-    double elastic0, kinetic0;
-} recorder;
-
-static int record_sample(void *self, const bk_sample *s, bk_error *err)
-{
-    (void)err;
-    recorder *r = self;
-    if (r->rows > 0 && !(s->t > r->last_t))
-        r->time_decreased = 1;
-    if (r->rows == 0) {
-        r->elastic0 = s->elastic_energy;
-        r->kinetic0 = s->kinetic_energy;
-    }
-    r->last_t = s->t;
-    r->rows++;
-    double balance = s->work_driver - (s->elastic_energy - r->elastic0) -
-                     (s->kinetic_energy - r->kinetic0) - s->dissipation;
-    r->max_balance_error = fmax(r->max_balance_error, fabs(balance));
-    r->max_work = fmax(r->max_work, fabs(s->work_driver));
-    return BK_OK;
-}
-
-static int record_transition(void *self, const bk_transition *t, bk_error *err)
-{
-    (void)err;
-    recorder *r = self;
-    if (r->n_transitions == r->cap_transitions) {
-        size_t cap = r->cap_transitions ? 2 * r->cap_transitions : 64;
-        bk_transition *grown = realloc(r->transitions, cap * sizeof *grown);
-        if (!grown)
-            return BK_ERR_NOMEM;
-        r->transitions = grown;
-        r->cap_transitions = cap;
-    }
-    r->transitions[r->n_transitions++] = *t;
-    return BK_OK;
-}
-
-static void recorder_free(recorder *r) { free(r->transitions); }
-
-/* --- scenes built in code (as in test_run.c) ------------------------------------------- */
-
-typedef struct scene_spec {
-    size_t n;
-    double mass, stiffness, coupling, mu_s, mu_d, velocity, t_end, rtol, interval;
-    bk_spring spring;
-    bk_boundary boundary;
-    const char *method;
-} scene_spec;
-
-static scene_spec paper_case(double mu_d, bk_spring spring, const char *method)
-{
-    return (scene_spec){.n = 1, .mass = 1.0, .stiffness = 1e4, .coupling = 0.0, .mu_s = 0.6,
-                        .mu_d = mu_d, .velocity = 1e-3, .t_end = 5.0, .rtol = 1e-10,
-                        .interval = 1e-3, .spring = spring, .boundary = BK_BOUNDARY_FREE,
-                        .method = method};
-}
-
-static bk_config *make_config(const scene_spec *spec)
-{
-    bk_config *c = calloc(1, sizeof *c);
-    assert_non_null(c);
-    bk_model *m = bk_model_create(spec->n);
-    assert_non_null(m);
-    m->boundary = spec->boundary;
-    m->coupling_stiffness = spec->coupling;
-    m->gravity = 9.81;
-    m->spring = spec->spring;
-    m->driver.velocity = spec->velocity;
-    for (size_t i = 0; i < spec->n; ++i) {
-        bk_block *b = &m->blocks[i];
-        b->mass = spec->mass;
-        b->driver_stiffness = spec->stiffness;
-        b->normal_force = spec->mass * 9.81;
-        b->law = &bk_friction_coulomb;
-        b->friction_params[0] = spec->mu_s;
-        b->friction_params[1] = spec->mu_d;
-    }
-    bk_model_finalize(m);
-    c->model = m;
-    c->t_end = spec->t_end;
-    snprintf(c->solver.method, sizeof c->solver.method, "%s", spec->method);
-    snprintf(c->solver.linear_solver, sizeof c->solver.linear_solver, "auto");
-    c->solver.rtol = spec->rtol;
-    c->solver.atol_x = c->solver.atol_v = c->solver.max_step = NAN;
-    c->solver.max_steps = 1000000;
-    c->solver.detect_velocity_extrema = 1;
-    c->solver.max_transitions_per_instant = 100;
-    c->solver.instant_window = NAN;
-    c->output.interval = spec->interval;
-    c->output.fields = BK_FIELD_ALL;
-    c->output.transitions = 1;
-    c->output.event_rows = 1;
-    return c;
-}
-
-static void free_config(bk_config *c)
-{
-    bk_model_free(c->model);
-    free(c);
-}
-
-static int run_config(const bk_config *c, recorder *r, bk_run_stats *stats, bk_error *err)
-{
-    bk_sink sink = {.self = r, .sample = record_sample, .transition = record_transition};
-    return bk_run(c, &sink, stats, NULL, NULL, err);
-}
 
 static double relative(double a, double b) { return fabs(a - b) / fmax(fabs(b), DBL_MIN); }
 
@@ -443,15 +327,15 @@ typedef struct single_errors {
 
 static void compare_single(double mu_d, bk_spring spring)
 {
-    scene_spec spec = paper_case(mu_d, spring, "exact");
+    scene_spec spec = paper_case(mu_d, spring, 1e-10, "exact");
     exact_params p = {1.0, 1e4, 9.81, 0.6, mu_d, 1e-3, spring == BK_SPRING_TENSION_ONLY};
     exact_solution ex;
     assert_int_equal(exact_solve(&p, spec.t_end, &ex), 0);
-    bk_config *c = make_config(&spec);
+    bk_config *c = scene_config(&spec);
     recorder r = {0};
     bk_run_stats stats;
     bk_error err = {0};
-    assert_int_equal(run_config(c, &r, &stats, &err), BK_OK);
+    assert_int_equal(run_recorded(c, &r, &stats, &err), BK_OK);
     assert_int_equal(r.n_transitions, ex.n_events);
     assert_false(r.time_decreased);
     single_errors e = {0};
@@ -493,7 +377,7 @@ static void compare_single(double mu_d, bk_spring spring)
     assert_true(e.slip_distance <= 1e-12);
     assert_true(e.energy <= 1e-12);
     recorder_free(&r);
-    free_config(c);
+    bk_config_free(c);
     exact_free(&ex);
 }
 
@@ -532,13 +416,13 @@ static void test_case_c_tension_only(void **state)
 static void test_simultaneous_transitions(void **state)
 {
     (void)state;
-    scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, "exact");
+    scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, 1e-10, "exact");
     spec.n = 2;
     spec.coupling = 3e3;
-    bk_config *c = make_config(&spec);
+    bk_config *c = scene_config(&spec);
     recorder r = {0};
     bk_error err = {0};
-    assert_int_equal(run_config(c, &r, NULL, &err), BK_OK);
+    assert_int_equal(run_recorded(c, &r, NULL, &err), BK_OK);
     assert_int_equal(r.n_transitions, 20);
     for (size_t k = 0; k + 1 < r.n_transitions; k += 2) {
         assert_true(r.transitions[k].t == r.transitions[k + 1].t);
@@ -547,7 +431,7 @@ static void test_simultaneous_transitions(void **state)
         assert_int_equal(r.transitions[k].to, r.transitions[k + 1].to);
     }
     recorder_free(&r);
-    free_config(c);
+    bk_config_free(c);
 }
 
 /* A block launched at 0.5 m/s with the driver at rest swings back past its threshold: the
@@ -556,15 +440,15 @@ static void test_simultaneous_transitions(void **state)
 static void test_reversal(void **state)
 {
     (void)state;
-    scene_spec spec = paper_case(0.05, BK_SPRING_LINEAR, "exact");
+    scene_spec spec = paper_case(0.05, BK_SPRING_LINEAR, 1e-10, "exact");
     spec.velocity = 0.0;
     spec.t_end = 0.2;
-    bk_config *c = make_config(&spec);
+    bk_config *c = scene_config(&spec);
     c->model->blocks[0].v_init = 0.5;
     recorder r = {0};
     bk_run_stats stats;
     bk_error err = {0};
-    assert_int_equal(run_config(c, &r, &stats, &err), BK_OK);
+    assert_int_equal(run_recorded(c, &r, &stats, &err), BK_OK);
     assert_true(r.n_transitions >= 2);
     assert_int_equal(r.transitions[0].from, BK_MODE_SLIP_POS);
     assert_int_equal(r.transitions[0].to, BK_MODE_SLIP_NEG);
@@ -577,7 +461,7 @@ static void test_reversal(void **state)
     assert_close(r.transitions[0].x, x_stop, 1e-14, 0.0);
     assert_true(fabs(stats.energy_residual) <= 1e-13);
     recorder_free(&r);
-    free_config(c);
+    bk_config_free(c);
 }
 
 /* No driver springs: the pair slides on its coupling alone, with a free (w = 0) mode next to
@@ -589,19 +473,19 @@ static void test_free_mode(void **state)
     bk_run_stats stats[2];
     const char *methods[2] = {"exact", "cvode_adams"};
     for (int k = 0; k < 2; ++k) {
-        scene_spec spec = paper_case(0.3, BK_SPRING_LINEAR, methods[k]);
+        scene_spec spec = paper_case(0.3, BK_SPRING_LINEAR, 1e-10, methods[k]);
         spec.n = 2;
         spec.stiffness = 0.0;
         spec.coupling = 2e4;
         spec.velocity = 0.0;
         spec.t_end = 0.5;
         spec.rtol = 1e-12;
-        bk_config *c = make_config(&spec);
+        bk_config *c = scene_config(&spec);
         c->model->blocks[0].v_init = 0.4;
         c->model->blocks[1].v_init = 0.1;
         bk_error err = {0};
-        assert_int_equal(run_config(c, &r[k], &stats[k], &err), BK_OK);
-        free_config(c);
+        assert_int_equal(run_recorded(c, &r[k], &stats[k], &err), BK_OK);
+        bk_config_free(c);
     }
     assert_true(r[0].n_transitions >= 2);
     assert_int_equal(r[0].n_transitions, r[1].n_transitions);
@@ -626,13 +510,13 @@ static void test_free_mode(void **state)
 static bk_config *chain_config(bk_spring spring, bk_boundary boundary, const char *method,
                                double rtol, double t_end)
 {
-    scene_spec spec = paper_case(0.5, spring, method);
+    scene_spec spec = paper_case(0.5, spring, 1e-10, method);
     spec.n = 10;
     spec.coupling = 2e4;
     spec.boundary = boundary;
     spec.rtol = rtol;
     spec.t_end = t_end;
-    bk_config *c = make_config(&spec);
+    bk_config *c = scene_config(&spec);
     for (size_t i = 0; i < spec.n; ++i) {
         c->model->blocks[i].x_init = 1e-5 * sin(2.385 * (double)i);
         c->model->blocks[i].friction_params[1] = spring == BK_SPRING_LINEAR
@@ -659,8 +543,8 @@ static void test_chains_against_cvode(void **state)
             recorder re = {0}, rc = {0};
             bk_run_stats se, sc;
             bk_error err = {0};
-            assert_int_equal(run_config(ce, &re, &se, &err), BK_OK);
-            assert_int_equal(run_config(cc, &rc, &sc, &err), BK_OK);
+            assert_int_equal(run_recorded(ce, &re, &se, &err), BK_OK);
+            assert_int_equal(run_recorded(cc, &rc, &sc, &err), BK_OK);
             assert_true(re.n_transitions >= CHAIN_COMPARED);
             assert_true(rc.n_transitions >= CHAIN_COMPARED);
             double worst = 0.0;
@@ -684,8 +568,8 @@ static void test_chains_against_cvode(void **state)
             assert_false(re.time_decreased);
             recorder_free(&re);
             recorder_free(&rc);
-            free_config(ce);
-            free_config(cc);
+            bk_config_free(ce);
+            bk_config_free(cc);
         }
 }
 
@@ -696,14 +580,14 @@ static void test_chains_against_cvode(void **state)
  * a coupling would change the motion). */
 static bk_config *long_chain_config(bk_boundary boundary, const char *method, double rtol)
 {
-    scene_spec spec = paper_case(0.5, BK_SPRING_LINEAR, method);
+    scene_spec spec = paper_case(0.5, BK_SPRING_LINEAR, 1e-10, method);
     spec.n = 64;
     spec.coupling = 2e4;
     spec.boundary = boundary;
     spec.rtol = rtol;
     spec.t_end = 0.6;
     spec.interval = 1e-2;
-    bk_config *c = make_config(&spec);
+    bk_config *c = scene_config(&spec);
     unsigned long state = 2385;
     for (size_t i = 0; i < spec.n; ++i) {
         state = (state * 6364136223846793005ul + 1442695040888963407ul) & 0xfffffffffffffffful;
@@ -726,8 +610,8 @@ static void test_long_chain_clusters(void **state)
         recorder re = {0}, rc = {0};
         bk_run_stats se, sc;
         bk_error err = {0};
-        assert_int_equal(run_config(ce, &re, &se, &err), BK_OK);
-        assert_int_equal(run_config(cc, &rc, &sc, &err), BK_OK);
+        assert_int_equal(run_recorded(ce, &re, &se, &err), BK_OK);
+        assert_int_equal(run_recorded(cc, &rc, &sc, &err), BK_OK);
         assert_true(re.n_transitions >= 100);
         assert_int_equal(re.n_transitions, rc.n_transitions);
         double worst = 0.0;
@@ -746,8 +630,8 @@ static void test_long_chain_clusters(void **state)
         assert_true(fabs(se.energy_residual) <= 1e-11);
         recorder_free(&re);
         recorder_free(&rc);
-        free_config(ce);
-        free_config(cc);
+        bk_config_free(ce);
+        bk_config_free(cc);
     }
 }
 

@@ -9,6 +9,7 @@
 #include "bk_test.h"
 #include "bksim/bksim.h"
 #include "exact_single.h"
+#include "recorder.h"
 
 typedef struct extreme {
     const char *name;
@@ -51,46 +52,9 @@ static double scaled_wall_limit(void)
     return WALL_LIMIT * (factor >= 1.0 ? factor : 1.0);
 }
 
-typedef struct recorder {
-    bk_transition *tr;
-    size_t n, cap;
-    int non_finite;
-    exact_solution *exact; /* when set: worst |x - x_exact| over the samples */
-    double worst_x;
-} recorder;
-
-static int check_sample(void *self, const bk_sample *s, bk_error *err)
-{
-    (void)err;
-    recorder *r = self;
-    for (size_t i = 0; i < s->n_blocks; ++i)
-        if (!isfinite(s->x[i]) || !isfinite(s->v[i]) || !isfinite(s->friction[i]))
-            r->non_finite = 1;
-    if (r->exact && !s->is_event) { /* event rows sit at the run's own transition times */
-        double x, v;
-        exact_state(r->exact, s->t, &x, &v);
-        r->worst_x = fmax(r->worst_x, fabs(s->x[0] - x));
-    }
-    return BK_OK;
-}
-
-static int keep_transition(void *self, const bk_transition *t, bk_error *err)
-{
-    (void)err;
-    recorder *r = self;
-    if (r->n == r->cap) {
-        r->cap = r->cap ? 2 * r->cap : 64;
-        bk_transition *grown = realloc(r->tr, r->cap * sizeof *grown);
-        if (!grown)
-            return BK_ERR_NOMEM;
-        r->tr = grown;
-    }
-    r->tr[r->n++] = *t;
-    return BK_OK;
-}
-
-static int run_scene(const char *text, const char *method, double rtol, double wall_limit, recorder *r,
-                     bk_run_stats *stats, bk_error *err)
+/* With exact: its parameters solved to the scene's t_end, and r tracking the distance from it. */
+static int run_scene(const char *text, const char *method, double rtol, double wall_limit, exact_solution *exact,
+                     recorder *r, bk_run_stats *stats, bk_error *err)
 {
     char set_method[64], set_rtol[64];
     snprintf(set_method, sizeof set_method, "solver.method=%s", method);
@@ -101,10 +65,11 @@ static int run_scene(const char *text, const char *method, double rtol, double w
     if (rc != BK_OK)
         return rc;
     c->wall_time_limit = wall_limit;
-    if (r->exact)
-        assert_int_equal(exact_solve(&r->exact->p, c->t_end, r->exact), 0);
-    bk_sink sink = {.self = r, .sample = check_sample, .transition = keep_transition};
-    rc = bk_run(c, &sink, stats, NULL, NULL, err);
+    if (exact) {
+        assert_int_equal(exact_solve(&exact->p, c->t_end, exact), 0);
+        r->exact = exact;
+    }
+    rc = run_recorded(c, r, stats, err);
     bk_config_free(c);
     assert_false(r->non_finite);
     return rc;
@@ -123,11 +88,11 @@ static const char *judge_coulomb(const extreme *e, const recorder *r, char *deta
      * grazing stops (and the breakaways after them) were missed. */
     double worst_t = 0.0;
     size_t next = 0, breakaways = 0;
-    for (size_t k = 0; k < r->n; ++k) {
-        if (r->tr[k].from != BK_MODE_STICK)
+    for (size_t k = 0; k < r->n_transitions; ++k) {
+        if (r->transitions[k].from != BK_MODE_STICK)
             continue;
         ++breakaways;
-        double t = r->tr[k].t;
+        double t = r->transitions[k].t;
         while (next < ex->n_events && (ex->events[next].from != BK_MODE_STICK || ex->events[next].t < t * (1.0 - 1e-5)))
             ++next; /* stops, and breakaways the run skipped by sliding through a grazing stop */
         worst_t = fmax(worst_t, next < ex->n_events ? fabs(t - ex->events[next].t) / ex->events[next].t : INFINITY);
@@ -137,15 +102,15 @@ static const char *judge_coulomb(const extreme *e, const recorder *r, char *deta
     double amplitude = 2.0 * (0.6 - e->mu_d) * e->mass * 9.81 / e->k;
     double rtol_floor = 10.0 * RTOL * e->velocity * ex->phases[ex->n_phases - 1].t0;
     snprintf(detail, len, "%zu/%zu transitions, breakaway time error %.1e, position error %.1e of the amplitude",
-             r->n, ex->n_events, worst_t, r->worst_x / amplitude);
-    if (!(worst_t < 1e-5 && r->worst_x < 0.05 * amplitude + rtol_floor))
+             r->n_transitions, ex->n_events, worst_t, r->max_position_error_regular / amplitude);
+    if (!(worst_t < 1e-5 && r->max_position_error_regular < 0.05 * amplitude + rtol_floor))
         print_message("%s: %s\n", e->name, detail);
     assert_true(worst_t < 1e-5);
-    assert_true(r->worst_x < 0.05 * amplitude + rtol_floor);
+    assert_true(r->max_position_error_regular < 0.05 * amplitude + rtol_floor);
     /* Missing stops is only excusable where every stop grazes (mu_s - mu_d = 1e-6). */
-    if (r->n != ex->n_events)
+    if (r->n_transitions != ex->n_events)
         assert_true(0.6 - e->mu_d < 1e-5);
-    return r->n == ex->n_events ? "ok" : "ok*";
+    return r->n_transitions == ex->n_events ? "ok" : "ok*";
 }
 
 /* Rate-and-state: against cvode_bdf converged at rtol 1e-11, transition by transition. */
@@ -153,13 +118,14 @@ static const char *judge_reference(const extreme *e, const recorder *r, const re
                                    const bk_run_stats *stats, char *detail, size_t len)
 {
     double worst_t = 0.0;
-    for (size_t k = 0; r->n == reference->n && k < r->n; ++k)
-        worst_t = fmax(worst_t, fabs(r->tr[k].t - reference->tr[k].t) / reference->tr[k].t);
-    snprintf(detail, len, "%zu/%zu transitions, time error %.1e, energy residual %.1e", r->n, reference->n,
-             worst_t, stats->energy_residual);
-    if (!(r->n == reference->n && worst_t < 1e-5 && fabs(stats->energy_residual) < 1e-6))
+    int same_count = r->n_transitions == reference->n_transitions;
+    for (size_t k = 0; same_count && k < r->n_transitions; ++k)
+        worst_t = fmax(worst_t, fabs(r->transitions[k].t - reference->transitions[k].t) / reference->transitions[k].t);
+    snprintf(detail, len, "%zu/%zu transitions, time error %.1e, energy residual %.1e", r->n_transitions,
+             reference->n_transitions, worst_t, stats->energy_residual);
+    if (!(same_count && worst_t < 1e-5 && fabs(stats->energy_residual) < 1e-6))
         print_message("%s: %s\n", e->name, detail);
-    assert_int_equal(r->n, reference->n);
+    assert_int_equal(r->n_transitions, reference->n_transitions);
     assert_true(worst_t < 1e-5);
     assert_true(fabs(stats->energy_residual) < 1e-6);
     return "ok";
@@ -170,13 +136,12 @@ static void outcome(const extreme *e, const char *method, const recorder *refere
 {
     recorder r = {0};
     exact_solution ex = {.p = {e->mass, e->k, e->mass * 9.81, 0.6, e->mu_d, e->velocity, 0}};
-    if (e->coulomb_single)
-        r.exact = &ex;
     bk_run_stats stats = {0};
     bk_error err = {0};
     char detail[BK_ERROR_MESSAGE_LEN + 64];
     const char *verdict;
-    int rc = run_scene(e->text, method, RTOL, scaled_wall_limit(), &r, &stats, &err);
+    int rc = run_scene(e->text, method, RTOL, scaled_wall_limit(), e->coulomb_single ? &ex : NULL, &r, &stats,
+                       &err);
     if (rc != BK_OK) {
         /* The exact stepper refuses non-affine scenes at load time; nothing else may fail. */
         verdict = "n/a";
@@ -199,7 +164,7 @@ static void outcome(const extreme *e, const char *method, const recorder *refere
     if (getenv("BK_EXTREMES_VERBOSE"))
         print_message("  %s / %s: %s\n", e->name, method, detail);
     exact_free(&ex);
-    free(r.tr);
+    recorder_free(&r);
 }
 
 static void test_extremes(void **state)
@@ -216,7 +181,8 @@ static void test_extremes(void **state)
         recorder reference = {0};
         if (!extremes[k].coulomb_single) {
             bk_error err = {0};
-            assert_int_equal(run_scene(extremes[k].text, "cvode_bdf", 1e-11, 600.0, &reference, NULL, &err), BK_OK);
+            assert_int_equal(run_scene(extremes[k].text, "cvode_bdf", 1e-11, 600.0, NULL, &reference, NULL, &err),
+                             BK_OK);
         }
         char line[1024];
         snprintf(line, sizeof line, "| %s |", extremes[k].name);
@@ -228,7 +194,7 @@ static void test_extremes(void **state)
             strcat(line, " |");
         }
         print_message("%s\n", line);
-        free(reference.tr);
+        recorder_free(&reference);
     }
 }
 
@@ -256,15 +222,14 @@ static void test_long_run_phase(void **state)
         bk_error err = {0};
         assert_int_equal(bk_config_load_string(SINGLE(1, 1e4, 0.5, 1e-3, 2300, 0), "long.ini", overrides, 1, &c, &err), BK_OK);
         recorder r = {0};
-        bk_sink sink = {.self = &r, .sample = check_sample, .transition = keep_transition};
-        assert_int_equal(bk_run(c, &sink, NULL, NULL, NULL, &err), BK_OK);
-        assert_int_equal(r.n, ex.n_events);
+        assert_int_equal(run_recorded(c, &r, NULL, &err), BK_OK);
+        assert_int_equal(r.n_transitions, ex.n_events);
         double early = 0.0, late = 0.0;
-        for (size_t k = 0; k < r.n; ++k) {
-            double e = fabs(r.tr[k].t - ex.events[k].t);
+        for (size_t k = 0; k < r.n_transitions; ++k) {
+            double e = fabs(r.transitions[k].t - ex.events[k].t);
             if (k < 2 * window)
                 early = fmax(early, e);
-            else if (k + 2 * window >= r.n)
+            else if (k + 2 * window >= r.n_transitions)
                 late = fmax(late, e);
         }
         print_message("%s: %zu cycles, phase error %.2g s over the first %zu cycles, %.2g s over the last "
@@ -279,7 +244,7 @@ static void test_long_run_phase(void **state)
             assert_true(late < 10.0 * RTOL * period * (double)cycles);
             assert_true(late < 3.0 * (double)cycles / (double)window * fmax(early, 1e-3 * RTOL * period));
         }
-        free(r.tr);
+        recorder_free(&r);
         bk_config_free(c);
     }
     exact_free(&ex);

@@ -8,142 +8,14 @@
 #include "bk_test.h"
 #include "bksim/bksim.h"
 #include "exact_single.h"
-
-/* --- a memory sink --------------------------------------------------------------------- */
-
-typedef struct recorder {
-    bk_transition *transitions;
-    size_t n_transitions, cap_transitions;
-    size_t rows;
-    double last_t;
-    int time_decreased;
-    const exact_solution *exact; /* when set: track the position error at every row */
-    double max_position_error;
-    double max_balance_error;    /* |W - dE_el - dE_kin - D| over rows */
-    double elastic0, kinetic0;
-} recorder;
-
-static int record_sample(void *self, const bk_sample *s, bk_error *err)
-{
-    (void)err;
-    recorder *r = self;
-    if (r->rows > 0 && !(s->t > r->last_t))
-        r->time_decreased = 1;
-    if (r->rows == 0) {
-        r->elastic0 = s->elastic_energy;
-        r->kinetic0 = s->kinetic_energy;
-    }
-    r->last_t = s->t;
-    r->rows++;
-    double balance = s->work_driver - (s->elastic_energy - r->elastic0) -
-                     (s->kinetic_energy - r->kinetic0) - s->dissipation;
-    if (fabs(balance) > r->max_balance_error)
-        r->max_balance_error = fabs(balance);
-    if (r->exact) {
-        double x, v;
-        exact_state(r->exact, s->t, &x, &v);
-        if (fabs(s->x[0] - x) > r->max_position_error)
-            r->max_position_error = fabs(s->x[0] - x);
-    }
-    return BK_OK;
-}
-
-static int record_transition(void *self, const bk_transition *t, bk_error *err)
-{
-    (void)err;
-    recorder *r = self;
-    if (r->n_transitions == r->cap_transitions) {
-        size_t cap = r->cap_transitions ? 2 * r->cap_transitions : 64;
-        bk_transition *grown = realloc(r->transitions, cap * sizeof *grown);
-        if (!grown)
-            return BK_ERR_NOMEM;
-        r->transitions = grown;
-        r->cap_transitions = cap;
-    }
-    r->transitions[r->n_transitions++] = *t;
-    return BK_OK;
-}
-
-static void recorder_free(recorder *r) { free(r->transitions); }
-
-/* --- scenes built in code (the parser has its own tests) ------------------------------- */
-
-typedef struct scene_spec {
-    size_t n;
-    double mass, stiffness, coupling, mu_s, mu_d, velocity, t_end, rtol, interval;
-    bk_spring spring;
-    bk_boundary boundary;
-    const char *method;
-    int detect_extrema;
-    long max_per_instant;
-} scene_spec;
-
-static scene_spec paper_case(double mu_d, bk_spring spring, double rtol)
-{
-    return (scene_spec){.n = 1, .mass = 1.0, .stiffness = 1e4, .coupling = 0.0, .mu_s = 0.6,
-                        .mu_d = mu_d, .velocity = 1e-3, .t_end = 5.0, .rtol = rtol,
-                        .interval = 1e-3, .spring = spring, .boundary = BK_BOUNDARY_FREE,
-                        .method = "cvode_adams", .detect_extrema = 1, .max_per_instant = 100};
-}
-
-static bk_config *make_config(const scene_spec *spec)
-{
-    bk_config *c = calloc(1, sizeof *c);
-    assert_non_null(c);
-    bk_model *m = bk_model_create(spec->n);
-    assert_non_null(m);
-    m->boundary = spec->boundary;
-    m->coupling_stiffness = spec->coupling;
-    m->gravity = 9.81;
-    m->spring = spec->spring;
-    m->driver.velocity = spec->velocity;
-    for (size_t i = 0; i < spec->n; ++i) {
-        bk_block *b = &m->blocks[i];
-        b->mass = spec->mass;
-        b->driver_stiffness = spec->stiffness;
-        b->normal_force = spec->mass * 9.81;
-        b->law = &bk_friction_coulomb;
-        b->friction_params[0] = spec->mu_s;
-        b->friction_params[1] = spec->mu_d;
-    }
-    bk_model_finalize(m);
-    c->model = m;
-    c->t_end = spec->t_end;
-    snprintf(c->solver.method, sizeof c->solver.method, "%s", spec->method);
-    snprintf(c->solver.linear_solver, sizeof c->solver.linear_solver, "auto");
-    c->solver.rtol = spec->rtol;
-    c->solver.atol_x = c->solver.atol_v = c->solver.max_step = NAN;
-    c->solver.max_steps = 1000000;
-    c->solver.detect_velocity_extrema = spec->detect_extrema;
-    c->solver.max_transitions_per_instant = spec->max_per_instant;
-    c->solver.instant_window = NAN;
-    c->output.interval = spec->interval;
-    c->output.fields = BK_FIELD_ALL;
-    c->output.transitions = 1;
-    c->output.event_rows = 1;
-    return c;
-}
-
-static void free_config(bk_config *c)
-{
-    bk_model_free(c->model);
-    free(c);
-}
-
-static int run_spec(const scene_spec *spec, recorder *r, bk_run_stats *stats, bk_error *err)
-{
-    bk_config *c = make_config(spec);
-    bk_sink sink = {.self = r, .sample = record_sample, .transition = record_transition};
-    int rc = bk_run(c, &sink, stats, NULL, NULL, err);
-    free_config(c);
-    return rc;
-}
+#include "recorder.h"
+#include "scene_spec.h"
 
 /* --- the Coulomb single block against its closed form ---------------------------------- */
 
 static void compare_with_exact(double mu_d, bk_spring spring)
 {
-    scene_spec spec = paper_case(mu_d, spring, 1e-10);
+    scene_spec spec = paper_case(mu_d, spring, 1e-10, "cvode_adams");
     exact_params p = {1.0, 1e4, 9.81, 0.6, mu_d, 1e-3, spring == BK_SPRING_TENSION_ONLY};
     exact_solution ex;
     assert_int_equal(exact_solve(&p, spec.t_end, &ex), 0);
@@ -232,7 +104,7 @@ static void test_case_c_tension_only(void **state)
 static void test_case_a_paper_numbers(void **state)
 {
     (void)state;
-    scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, 1e-10);
+    scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, 1e-10, "cvode_adams");
     recorder r = {0};
     bk_error err = {0};
     assert_int_equal(run_spec(&spec, &r, NULL, &err), BK_OK);
@@ -257,7 +129,7 @@ static void test_error_shrinks_with_rtol(void **state)
         double previous = INFINITY;
         const double rtols[] = {1e-5, 1e-7, 1e-9, 1e-11};
         for (size_t k = 0; k < 4; ++k) {
-            scene_spec spec = paper_case(mu_d[c], BK_SPRING_LINEAR, rtols[k]);
+            scene_spec spec = paper_case(mu_d[c], BK_SPRING_LINEAR, rtols[k], "cvode_adams");
             recorder r = {0};
             r.exact = &ex;
             bk_error err = {0};
@@ -284,7 +156,7 @@ static void test_case_c_hidden_stops(void **state)
     assert_int_equal(ex.n_events, 141);
     const double rtols[] = {1e-6, 1e-8};
     for (size_t k = 0; k < 2; ++k) {
-        scene_spec spec = paper_case(0.5999, BK_SPRING_LINEAR, rtols[k]);
+        scene_spec spec = paper_case(0.5999, BK_SPRING_LINEAR, rtols[k], "cvode_adams");
         recorder with = {0}, without = {0};
         bk_error err = {0};
         assert_int_equal(run_spec(&spec, &with, NULL, &err), BK_OK);
@@ -311,7 +183,7 @@ static void test_no_refire_after_restart(void **state)
     const char *methods[] = {"cvode_adams", "cvode_bdf"};
     for (size_t m = 0; m < 2; ++m)
         for (size_t c = 0; c < 3; ++c) {
-            scene_spec spec = paper_case(mu_d[c], BK_SPRING_LINEAR, 1e-9);
+            scene_spec spec = paper_case(mu_d[c], BK_SPRING_LINEAR, 1e-9, "cvode_adams");
             spec.method = methods[m];
             recorder r = {0};
             bk_error err = {0};
@@ -328,7 +200,7 @@ static void test_no_refire_after_restart(void **state)
 
 static scene_spec chain(size_t n, double rtol)
 {
-    scene_spec s = paper_case(0.5, BK_SPRING_LINEAR, rtol);
+    scene_spec s = paper_case(0.5, BK_SPRING_LINEAR, rtol, "cvode_adams");
     s.n = n;
     s.coupling = 2e4;
     s.t_end = 3.0;
@@ -345,17 +217,16 @@ static void check_energy(size_t n, bk_spring spring, bk_boundary boundary)
         scene_spec spec = chain(n, rtols[k]);
         spec.spring = spring;
         spec.boundary = boundary;
-        bk_config *c = make_config(&spec);
+        bk_config *c = scene_config(&spec);
         /* Break the symmetry so blocks slip at different times. */
         for (size_t i = 0; i < n; ++i) {
             c->model->blocks[i].x_init = 1e-5 * sin(2.385 * (double)i);
             c->model->blocks[i].friction_params[1] = 0.45 + 0.01 * (double)(i % 5);
         }
         recorder r = {0};
-        bk_sink sink = {.self = &r, .sample = record_sample, .transition = record_transition};
         bk_run_stats stats;
         bk_error err = {0};
-        assert_int_equal(bk_run(c, &sink, &stats, NULL, NULL, &err), BK_OK);
+        assert_int_equal(run_recorded(c, &r, &stats, &err), BK_OK);
         double residual = fabs(stats.energy_residual);
         print_message("%zu blocks rtol %g: %zu transitions, energy residual %.3g, work %.4g J\n", n,
                       rtols[k], r.n_transitions, residual, stats.work_driver);
@@ -366,7 +237,7 @@ static void check_energy(size_t n, bk_spring spring, bk_boundary boundary)
         assert_true(residual < previous || residual < 1e-12);
         previous = residual;
         recorder_free(&r);
-        free_config(c);
+        bk_config_free(c);
     }
 }
 
@@ -389,7 +260,7 @@ static void test_energy_ten_blocks(void **state)
 static void test_simultaneous_transitions(void **state)
 {
     (void)state;
-    scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, 1e-10);
+    scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, 1e-10, "cvode_adams");
     spec.n = 2;
     spec.coupling = 3e3; /* coupled, but symmetric: the coupling never stretches */
     recorder r = {0};
@@ -410,16 +281,15 @@ static void test_simultaneous_transitions(void **state)
 static void test_reversal(void **state)
 {
     (void)state;
-    scene_spec spec = paper_case(0.05, BK_SPRING_LINEAR, 1e-10);
+    scene_spec spec = paper_case(0.05, BK_SPRING_LINEAR, 1e-10, "cvode_adams");
     spec.velocity = 0.0;
     spec.t_end = 0.2;
-    bk_config *c = make_config(&spec);
+    bk_config *c = scene_config(&spec);
     /* Start sliding fast with no driver motion: the spring swings it back past its threshold. */
     c->model->blocks[0].v_init = 0.5;
     recorder r = {0};
-    bk_sink sink = {.self = &r, .sample = record_sample, .transition = record_transition};
     bk_error err = {0};
-    assert_int_equal(bk_run(c, &sink, NULL, NULL, NULL, &err), BK_OK);
+    assert_int_equal(run_recorded(c, &r, NULL, &err), BK_OK);
     assert_true(r.n_transitions >= 2);
     assert_int_equal(r.transitions[0].from, BK_MODE_SLIP_POS);
     assert_int_equal(r.transitions[0].to, BK_MODE_SLIP_NEG);
@@ -427,26 +297,25 @@ static void test_reversal(void **state)
     /* Energy bookkeeping covers the reversal. */
     assert_true(r.max_balance_error < 1e-8);
     recorder_free(&r);
-    free_config(c);
+    bk_config_free(c);
 }
 
 /* Transitions piling up at one instant stop the run with a message naming block and time. */
 static void test_chattering_guard(void **state)
 {
     (void)state;
-    scene_spec spec = paper_case(0.5999, BK_SPRING_LINEAR, 1e-8);
+    scene_spec spec = paper_case(0.5999, BK_SPRING_LINEAR, 1e-8, "cvode_adams");
     spec.max_per_instant = 1;
-    bk_config *c = make_config(&spec);
+    bk_config *c = scene_config(&spec);
     /* Stop and breakaway 0.2 ms apart count as one instant in a 1 ms window. */
     c->solver.instant_window = 1e-3;
     recorder r = {0};
-    bk_sink sink = {.self = &r, .sample = record_sample, .transition = record_transition};
     bk_error err = {0};
-    assert_int_equal(bk_run(c, &sink, NULL, NULL, NULL, &err), BK_ERR_ZENO);
+    assert_int_equal(run_recorded(c, &r, NULL, &err), BK_ERR_ZENO);
     assert_non_null(strstr(err.message, "block 0"));
     assert_non_null(strstr(err.message, "t = 0.6514"));
     recorder_free(&r);
-    free_config(c);
+    bk_config_free(c);
 }
 
 /* A progress callback can stop a run. */
@@ -460,28 +329,28 @@ static int stop_at_one_second(void *user, double t, double t_end)
 static void test_interrupt(void **state)
 {
     (void)state;
-    scene_spec spec = paper_case(0.5, BK_SPRING_LINEAR, 1e-8);
-    bk_config *c = make_config(&spec);
+    scene_spec spec = paper_case(0.5, BK_SPRING_LINEAR, 1e-8, "cvode_adams");
+    bk_config *c = scene_config(&spec);
     recorder r = {0};
-    bk_sink sink = {.self = &r, .sample = record_sample, .transition = record_transition};
+    bk_sink sink = recorder_sink(&r);
     bk_error err = {0};
     assert_int_equal(bk_run(c, &sink, NULL, stop_at_one_second, NULL, &err), BK_ERR_INTERRUPTED);
     assert_true(r.last_t < 1.2);
     recorder_free(&r);
-    free_config(c);
+    bk_config_free(c);
     /* Also while every block is stuck and the run only writes rows (1e7 of them here, the
      * first breakaway at 5.9e6 s): the request is seen at the next row. */
     spec.velocity = 1e-9;
     spec.t_end = 1e5;
     spec.interval = 0.01;
-    c = make_config(&spec);
+    c = scene_config(&spec);
     recorder stuck = {0};
     sink.self = &stuck;
     assert_int_equal(bk_run(c, &sink, NULL, stop_at_one_second, NULL, &err), BK_ERR_INTERRUPTED);
     assert_int_equal(stuck.n_transitions, 0);
     assert_true(stuck.last_t > 0.99 && stuck.last_t < 1.02);
     recorder_free(&stuck);
-    free_config(c);
+    bk_config_free(c);
 }
 
 /* Rows: one per sample time plus one per transition instant, strictly increasing in time,
@@ -489,7 +358,7 @@ static void test_interrupt(void **state)
 static void test_rows(void **state)
 {
     (void)state;
-    scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, 1e-8);
+    scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, 1e-8, "cvode_adams");
     spec.interval = 0.01;
     recorder r = {0};
     bk_run_stats stats;
@@ -528,9 +397,8 @@ static void test_per_block_laws(void **state)
     assert_int_equal(m->blocks[1].state_offset, 0);
     assert_int_equal(m->blocks[3].state_offset, 1);
     recorder r = {0};
-    bk_sink sink = {.self = &r, .sample = record_sample, .transition = record_transition};
     bk_run_stats stats;
-    int rc = bk_run(c, &sink, &stats, NULL, NULL, &err);
+    int rc = run_recorded(c, &r, &stats, &err);
     if (rc != BK_OK)
         print_error("%s\n", err.message);
     assert_int_equal(rc, BK_OK);

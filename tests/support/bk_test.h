@@ -1,4 +1,4 @@
-/* Shared test helpers: cmocka 1.1.5 has no floating-point comparison with tolerances. */
+/* Test support: assert_close, as cmocka 1.1.5 has no floating-point comparison with tolerances. */
 #ifndef BK_TEST_H
 #define BK_TEST_H
 

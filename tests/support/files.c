@@ -1,0 +1,57 @@
+/* Files and directories for tests; see files.h. */
+#include "files.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+int path_exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+char *part_path(const char *path)
+{
+    static char part[256];
+    snprintf(part, sizeof part, "%s.part", path);
+    return part;
+}
+
+int make_temp_dir(char *dir, size_t size, const char *prefix)
+{
+    int len = snprintf(dir, size, "/tmp/%s_XXXXXX", prefix);
+    if (len < 0 || (size_t)len >= size)
+        return -1;
+    return mkdtemp(dir) ? 0 : -1;
+}
+
+int remove_tree(const char *path)
+{
+    struct stat st;
+    if (lstat(path, &st) != 0)
+        return errno == ENOENT ? 0 : -1;
+    if (!S_ISDIR(st.st_mode))
+        return unlink(path) == 0 ? 0 : -1;
+    int rc = 0;
+    DIR *d = opendir(path);
+    if (d) {
+        struct dirent *e;
+        while ((e = readdir(d)) != NULL) {
+            if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+                continue;
+            char child[512];
+            int len = snprintf(child, sizeof child, "%s/%s", path, e->d_name);
+            if (len < 0 || (size_t)len >= sizeof child || remove_tree(child) != 0)
+                rc = -1;
+        }
+        closedir(d);
+    } else {
+        rc = -1;
+    }
+    return rmdir(path) == 0 ? rc : -1;
+}

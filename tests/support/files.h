@@ -1,0 +1,18 @@
+/* Test support: files and directories of tests that write output (temporary directories,
+ * the .part name of an unfinished output). */
+#ifndef TEST_FILES_H
+#define TEST_FILES_H
+
+#include <stddef.h>
+
+/* 1 when path names anything (file or directory), else 0. */
+int path_exists(const char *path);
+/* "<path>.part", where bksim writes until a run finishes; one static buffer, overwritten by
+ * the next call. */
+char *part_path(const char *path);
+/* A fresh directory /tmp/<prefix>_XXXXXX, its name in dir; returns 0, or -1. */
+int make_temp_dir(char *dir, size_t size, const char *prefix);
+/* rm -rf path: returns 0 when nothing of it is left (or there was none), else -1. */
+int remove_tree(const char *path);
+
+#endif
