@@ -55,8 +55,10 @@ static void test_every_stat_described(void **state)
     unsigned char covered[sizeof(bk_run_stats)] = {0};
     for (size_t k = 0; k < bk_run_stats_n_fields; ++k) {
         const bk_stat_field *f = &bk_run_stats_fields[k];
-        cover(covered, sizeof covered, f->offset, f->is_long ? sizeof(long) : sizeof(double),
-              f->name);
+        size_t size = sizeof(double);
+        if (f->is_long)
+            size = sizeof(long);
+        cover(covered, sizeof covered, f->offset, size, f->name);
         assert_non_null(f->units);
     }
     cover(covered, sizeof covered, offsetof(bk_run_stats, method),
@@ -97,12 +99,11 @@ static void test_alloc_follows_table(void **state)
         assert_int_equal(cp.n_state, sizes[s][1]);
         for (size_t k = 0; k < bk_checkpoint_n_fields; ++k) {
             const bk_checkpoint_field *f = &bk_checkpoint_fields[k];
-            unsigned char *data = bk_checkpoint_field_data(f, &cp);
+            void *data = bk_checkpoint_field_data(f, &cp);
             assert_non_null(data);
             size_t count = bk_checkpoint_field_count(f, &cp);
-            size_t size = bk_checkpoint_type_size(f->type);
             if (count > 0)
-                memset(data, 0x5a, count * size);
+                memset(data, 0x5a, count * bk_checkpoint_type_size(f->type));
         }
         bk_checkpoint_free(&cp);
         assert_null(cp.x);
@@ -110,29 +111,64 @@ static void test_alloc_follows_table(void **state)
     }
 }
 
+/* Value i of a field, set from a double (integers take its integer part). */
+static void set_value(const bk_checkpoint_field *f, bk_checkpoint *cp, size_t i, double value)
+{
+    char *data = bk_checkpoint_field_data(f, cp);
+    size_t size = bk_checkpoint_type_size(f->type);
+    int8_t i8 = (int8_t)value;
+    uint8_t u8 = (uint8_t)value;
+    long l = (long)value;
+    const void *from = &value;
+    if (f->type == BK_CHECKPOINT_I8)
+        from = &i8;
+    else if (f->type == BK_CHECKPOINT_U8)
+        from = &u8;
+    else if (f->type == BK_CHECKPOINT_LONG)
+        from = &l;
+    memcpy(data + i * size, from, size);
+}
+
+static double get_value(const bk_checkpoint_field *f, bk_checkpoint *cp, size_t i)
+{
+    const char *data = bk_checkpoint_field_data(f, cp);
+    size_t size = bk_checkpoint_type_size(f->type);
+    int8_t i8;
+    uint8_t u8;
+    long l;
+    double d;
+    switch (f->type) {
+    case BK_CHECKPOINT_I8:
+        memcpy(&i8, data + i * size, size);
+        return i8;
+    case BK_CHECKPOINT_U8:
+        memcpy(&u8, data + i * size, size);
+        return u8;
+    case BK_CHECKPOINT_LONG:
+        memcpy(&l, data + i * size, size);
+        return (double)l;
+    case BK_CHECKPOINT_F64:
+        break;
+    }
+    memcpy(&d, data + i * size, size);
+    return d;
+}
+
 /* A checkpoint with distinct values everywhere (high-entropy, not round numbers). */
 static void fill(bk_checkpoint *cp)
 {
     for (size_t k = 0; k < bk_checkpoint_n_fields; ++k) {
         const bk_checkpoint_field *f = &bk_checkpoint_fields[k];
-        unsigned char *data = bk_checkpoint_field_data(f, cp);
         size_t count = bk_checkpoint_field_count(f, cp);
         for (size_t i = 0; i < count; ++i) {
             double value = 2.385 * (double)(k + 1) + 0.173 * (double)i;
-            switch (f->type) {
-            case BK_CHECKPOINT_I8:
-                ((int8_t *)data)[i] = (int8_t)((int)(k + i) % 3 - 1);
-                break;
-            case BK_CHECKPOINT_U8:
-                ((uint8_t *)data)[i] = (uint8_t)((k + i) % 2);
-                break;
-            case BK_CHECKPOINT_F64:
-                ((double *)data)[i] = value;
-                break;
-            case BK_CHECKPOINT_LONG:
-                ((long *)data)[i] = (long)(17 * k + 3 * i + 5);
-                break;
-            }
+            if (f->type == BK_CHECKPOINT_I8)
+                value = (double)((int)(k + i) % 3 - 1);
+            else if (f->type == BK_CHECKPOINT_U8)
+                value = (double)((k + i) % 2);
+            else if (f->type == BK_CHECKPOINT_LONG)
+                value = (double)(17 * k + 3 * i + 5);
+            set_value(f, cp, i, value);
         }
     }
     for (size_t k = 0; k < bk_run_stats_n_fields; ++k) {
@@ -151,21 +187,13 @@ static void fill(bk_checkpoint *cp)
 /* Perturb value i of field f by the smallest change its type allows. */
 static void nudge(const bk_checkpoint_field *f, bk_checkpoint *cp, size_t i)
 {
-    unsigned char *data = bk_checkpoint_field_data(f, cp);
-    switch (f->type) {
-    case BK_CHECKPOINT_I8:
-        ((int8_t *)data)[i] = (int8_t)(((int8_t *)data)[i] == 1 ? 0 : 1);
-        break;
-    case BK_CHECKPOINT_U8:
-        ((uint8_t *)data)[i] ^= 1u;
-        break;
-    case BK_CHECKPOINT_F64:
-        ((double *)data)[i] = nextafter(((double *)data)[i], INFINITY);
-        break;
-    case BK_CHECKPOINT_LONG:
-        ((long *)data)[i] += 1;
-        break;
-    }
+    double value = get_value(f, cp, i);
+    if (f->type == BK_CHECKPOINT_F64)
+        set_value(f, cp, i, nextafter(value, INFINITY));
+    else if (f->type == BK_CHECKPOINT_LONG)
+        set_value(f, cp, i, value + 1.0);
+    else /* modes and flags: a valid other value */
+        set_value(f, cp, i, value == 1.0 ? 0.0 : 1.0);
 }
 
 /* No value a restart uses escapes the checksum: changing any one of them (the last entry of

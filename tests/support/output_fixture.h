@@ -12,4 +12,7 @@ typedef struct output_fixture {
 int output_fixture_setup(void **state);
 int output_fixture_teardown(void **state);
 
+/* A cmocka test that runs in its own output fixture. */
+#define OUTPUT_TEST(test) cmocka_unit_test_setup_teardown(test, output_fixture_setup, output_fixture_teardown)
+
 #endif

@@ -45,3 +45,25 @@ bk_config *checkpointed_paper_config(const char *const *extra, size_t n_extra)
         fail_msg("%s", err.message);
     return config;
 }
+
+/* Run config into path: whole (checkpoints < 0) or stopped `samples` rows after that many
+ * checkpoints, leaving path.part. */
+void run_into(const bk_config *config, const char *path, int checkpoints, int samples)
+{
+    bk_h5_writer *w;
+    bk_error err = {0};
+    assert_int_equal(bk_h5_writer_open(&w, config, path, &err), BK_OK);
+    bk_sink inner = bk_h5_writer_sink(w);
+    stopping_sink stop = {inner, checkpoints < 0 ? -1 : checkpoints, samples};
+    bk_sink sink = stopping_sink_of(&stop);
+    bk_run_stats stats;
+    int rc = bk_run(config, checkpoints < 0 ? &inner : &sink, &stats, NULL, NULL, &err);
+    if (checkpoints < 0) {
+        if (rc != BK_OK)
+            fail_msg("%s", err.message);
+        assert_int_equal(bk_h5_writer_finish(w, &stats, &err), BK_OK);
+    } else {
+        assert_int_equal(rc, BK_ERR_INTERRUPTED);
+        bk_h5_writer_abandon(w, err.message, &stats);
+    }
+}

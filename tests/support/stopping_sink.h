@@ -25,4 +25,8 @@ bk_sink stopping_sink_of(stopping_sink *s);
  * to six more --set overrides; fails the test if it does not load. */
 bk_config *checkpointed_paper_config(const char *const *extra, size_t n_extra);
 
+/* Run config into path: whole (checkpoints < 0), or stopped `samples` rows after that many
+ * checkpoints, leaving path.part (abandoned, as a killed run would leave it). */
+void run_into(const bk_config *config, const char *path, int checkpoints, int samples);
+
 #endif

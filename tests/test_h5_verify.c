@@ -1,0 +1,152 @@
+/* The integrity check (src/output/h5_verify.c) on hand-damaged files: values that are not
+ * finite or not modes, missing datasets, disordered or invalid transitions, bytes flipped
+ * inside a chunk, and files from before the "datasets" record. */
+#include "bk_test.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include <hdf5.h>
+
+#include "bksim/bksim.h"
+#include "files.h"
+#include "h5_raw.h"
+#include "output_fixture.h"
+#include "output_files.h"
+#include "stopping_sink.h"
+
+static void test_verify_values(void **state)
+{
+    output_fixture *f = *state;
+    bk_error err = {0};
+    write_small(f->path, 0);
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+
+    double nan = NAN, inf = INFINITY, huge = 1e30;
+    write_small(f->path, 0);
+    poke(f->path, "x", 1, 2, H5T_NATIVE_DOUBLE, &nan);
+    expect_damaged(f->path, "/x row 1 column 2 is nan, not finite");
+
+    /* A large finite driver position is allowed; a non-finite one is not. */
+    write_small(f->path, 0);
+    poke(f->path, "driver", 2, 0, H5T_NATIVE_DOUBLE, &huge);
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+    poke(f->path, "driver", 2, 0, H5T_NATIVE_DOUBLE, &inf);
+    expect_damaged(f->path, "/driver row 2 is inf, not finite");
+
+    int8_t bad_mode = 77;
+    write_small(f->path, 0);
+    poke(f->path, "mode", 2, 1, H5T_NATIVE_INT8, &bad_mode);
+    expect_damaged(f->path, "/mode row 2 column 1 is 77, not a mode");
+
+    uint8_t bad_event = 2;
+    write_small(f->path, 0);
+    poke(f->path, "event", 0, 0, H5T_NATIVE_UINT8, &bad_event);
+    expect_damaged(f->path, "/event row 0 is 2, not 0 or 1");
+}
+
+static void test_verify_required_datasets(void **state)
+{
+    output_fixture *f = *state;
+    const char *names[] = {"x", "v", "transitions", "energy_kinetic", "driver"};
+    for (size_t k = 0; k < sizeof names / sizeof *names; ++k) {
+        write_small(f->path, 0);
+        hid_t file = H5Fopen(f->path, H5F_ACC_RDWR, H5P_DEFAULT);
+        assert_true(file >= 0);
+        char *recorded = attr_string(file, "datasets");
+        assert_string_equal(recorded, "time,driver,event,x,v,friction,cof,mode,energy_kinetic,"
+                                      "energy_elastic,work_driver,dissipation,transitions");
+        free(recorded);
+        assert_true(H5Ldelete(file, names[k], H5P_DEFAULT) >= 0);
+        H5Fclose(file);
+        char needle[64];
+        snprintf(needle, sizeof needle, "no /%s", names[k]);
+        expect_damaged(f->path, needle);
+    }
+    /* Datasets a run did not select are not required. */
+    bk_config *c = synthetic_config(2, BK_FIELD_X, 0, 0);
+    c->t_end = row_time(2);
+    write_file(f->path, c, 3, 0);
+    bk_error err = {0};
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+    bk_config_free(c);
+}
+
+static void test_verify_transitions(void **state)
+{
+    output_fixture *f = *state;
+    bk_transition ok[2] = {{.t = 0.05, .block = 0, .from = 0, .to = 1},
+                           {.t = 0.05, .block = 1, .from = 0, .to = -1}};
+    write_small_with(f->path, ok, 2);
+    bk_error err = {0};
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK); /* equal times are in order */
+
+    bk_transition backwards[2] = {{.t = 0.05, .block = 0, .from = 0, .to = 1},
+                                  {.t = 0.03, .block = 0, .from = 1, .to = 0}};
+    write_small_with(f->path, backwards, 2);
+    expect_damaged(f->path, "/transitions is not in time order at row 1");
+
+    bk_transition late[1] = {{.t = 0.5, .block = 2, .from = 0, .to = 1}};
+    write_small_with(f->path, late, 1);
+    expect_damaged(f->path, "/transitions row 0 is at t = 0.5 s, after the end of the run");
+
+    bk_transition early[1] = {{.t = -0.01, .block = 2, .from = 0, .to = 1}};
+    write_small_with(f->path, early, 1);
+    expect_damaged(f->path, "/transitions is not in time order at row 0");
+
+    bk_transition bad_mode[1] = {{.t = 0.1, .block = 1, .from = 0, .to = 3}};
+    write_small_with(f->path, bad_mode, 1);
+    expect_damaged(f->path, "/transitions row 0 goes from mode 0 to 3");
+
+    bk_transition nan_x[1] = {{.t = 0.1, .block = 1, .from = 0, .to = 1, .x = NAN}};
+    write_small_with(f->path, nan_x, 1);
+    expect_damaged(f->path, "/transitions row 0 has a value that is not finite");
+}
+
+/* Bytes damaged inside a chunk: the chunk's Fletcher32 checksum fails the read. */
+static void test_verify_flipped_chunk_bytes(void **state)
+{
+    output_fixture *f = *state;
+    write_small(f->path, 0);
+    clobber_chunk(f->path, "x", 1, 3 * sizeof(double));
+    expect_damaged(f->path, "/x rows 0..2 cannot be read");
+    bk_error err = {0};
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_ERR_DAMAGED);
+    assert_non_null(strstr(err.message, "HDF5:"));
+
+    write_small(f->path, 0);
+    clobber_chunk(f->path, "transitions", 2, 38);
+    expect_damaged(f->path, "/transitions");
+}
+
+/* A file from before the "datasets" record: what must be there follows from its config. */
+static void test_verify_file_without_dataset_record(void **state)
+{
+    output_fixture *f = *state;
+    const char *fields[] = {"output.fields=x mode"};
+    bk_config *config = checkpointed_paper_config(fields, 1);
+    run_into(config, f->path, -1, 0);
+    bk_config_free(config);
+    hid_t file = H5Fopen(f->path, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(file >= 0);
+    assert_true(H5Adelete(file, "datasets") >= 0);
+    H5Fclose(file);
+    bk_error err = {0};
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+    file = H5Fopen(f->path, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(H5Ldelete(file, "mode", H5P_DEFAULT) >= 0);
+    H5Fclose(file);
+    expect_damaged(f->path, "no /mode");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        OUTPUT_TEST(test_verify_values),
+        OUTPUT_TEST(test_verify_required_datasets),
+        OUTPUT_TEST(test_verify_transitions),
+        OUTPUT_TEST(test_verify_flipped_chunk_bytes),
+        OUTPUT_TEST(test_verify_file_without_dataset_record),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
