@@ -8,11 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <hdf5.h>
-
 #include "bksim/bksim.h"
-#include "files.h"
-#include "h5_raw.h"
 #include "output_fixture.h"
 #include "output_files.h"
 

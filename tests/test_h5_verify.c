@@ -9,7 +9,6 @@
 #include <hdf5.h>
 
 #include "bksim/bksim.h"
-#include "files.h"
 #include "h5_raw.h"
 #include "output_fixture.h"
 #include "output_files.h"

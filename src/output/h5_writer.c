@@ -143,11 +143,12 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
     }
 
     if (config->output.transitions) {
-        if (bk_h5_writer_transition_buffer(w) < 0 && !w->trans_buf)
-            return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for the transition buffer",
-                           w->part);
+        if (bk_h5_writer_transition_buffer(w) < 0)
+            return w->trans_buf ? H5_FAIL(err, "%s: cannot create dataset /transitions", w->part)
+                                : BK_FAIL(err, BK_ERR_NOMEM,
+                                          "%s: out of memory for the transition buffer", w->part);
         hid_t disk = bk_h5_transition_type(1);
-        if (w->trans_mem >= 0 && disk >= 0)
+        if (disk >= 0)
             w->trans_dset = create_extendable(w->file, "transitions", disk, 1, 1,
                                               TRANSITION_BUFFER);
         CLOSE_IDS(w->trans_dset, disk);
