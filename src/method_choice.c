@@ -47,28 +47,29 @@ double bk_stiffness_ratio(const bk_model *model)
     bk_scene probe;
     if (bk_scene_init(&probe, model, 0) != 0)
         return NAN;
-    size_t n = model->n_blocks, n_max = 2 * n + model->n_friction_state + 2;
+    /* Every block slipping: one island, the whole chain. */
+    size_t n = model->n_blocks, n_max = bk_island_max_y(&probe, n);
+    bk_island island = {.scene = &probe, .id = 0, .start = 0, .len = n};
     double *y = calloc(n_max, sizeof *y);
     double *diagonal = calloc(n_max, sizeof *diagonal);
     double *omega2 = calloc(n, sizeof *omega2);
     size_t *velocity_row_block = malloc(n_max * sizeof *velocity_row_block);
     double ratio = NAN;
-    if (y && diagonal && omega2 && velocity_row_block) {
+    if (y && diagonal && omega2 && velocity_row_block && bk_island_reserve(&island, n) == 0) {
         double speed = fabs(bk_driver_velocity(&model->driver, 0.0));
         for (size_t i = 0; i < n; ++i) {
             probe.mode[i] = BK_MODE_SLIP_POS;
             probe.v[i] = speed;
-            probe.taut[i] = 1;
         }
-        bk_scene_restart(&probe, 0.0, y);
+        bk_island_restart(&island, 0.0, y);
         for (size_t r = 0; r < n_max; ++r)
             velocity_row_block[r] = SIZE_MAX;
         for (size_t i = 0; i < n; ++i)
             velocity_row_block[probe.slot[i] + 1] = i;
         probe_matrix m = {&probe, diagonal, omega2, velocity_row_block};
-        if (bk_scene_jacobian(0.0, y, &probe, put_entry, &m) == 0) {
+        if (bk_island_jacobian(0.0, y, &island, put_entry, &m) == 0) {
             double decay = 0.0, omega2_max = 0.0;
-            for (size_t r = 0; r < probe.n_y; ++r)
+            for (size_t r = 0; r < island.n_y; ++r)
                 decay = fmax(decay, -diagonal[r]);
             for (size_t i = 0; i < n; ++i)
                 omega2_max = fmax(omega2_max, omega2[i]);
@@ -79,6 +80,7 @@ double bk_stiffness_ratio(const bk_model *model)
     free(diagonal);
     free(omega2);
     free(velocity_row_block);
+    bk_island_free(&island);
     bk_scene_free(&probe);
     return ratio;
 }

@@ -1,24 +1,12 @@
-/* The compact ODE of a chain with per-block modes, or IDA's full-layout DAE (layouts in
- * scene.h): right-hand side, root functions, and packing between the chain's arrays and
- * the integrator's vector.
- *
- * Root functions, per block (all clearly non-zero right after the block switched, so a
- * just-handled root cannot fire again after a restart):
- *   stuck:    g = F_s - |F|                    falls through 0 at breakaway
- *   slipping: g = s v / (t - t_switch)         falls through 0 at the stop; at t_switch it
- *             (s v when the slip did not        equals its limit s a > 0 instead of 0
- *              start from rest)
- *             g = s a                          rises through 0 at a slip-rate minimum, where
- *                                              a stop hidden inside one step shows as s v < 0
- *   tension-only spring: g = D - x             the spring's kink (slack/taut) */
+/* The chain's state during a run (scene.h): per-block arrays, forces and thresholds on the
+ * unpacked positions, friction states at rest, and the driver springs' energy.  The islands'
+ * ODEs are in island.c. */
 #include "scene.h"
 
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define NO_SLOT SIZE_MAX
 
 int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
 {
@@ -33,25 +21,22 @@ int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
     scene->x = calloc(n, sizeof *scene->x);
     scene->v = calloc(n, sizeof *scene->v);
     scene->state = calloc(model->n_friction_state + 1, sizeof *scene->state);
+    scene->state_time = calloc(n, sizeof *scene->state_time);
     scene->normal = calloc(n, sizeof *scene->normal);
     scene->t_switch = calloc(n, sizeof *scene->t_switch);
     scene->from_rest = calloc(n, sizeof *scene->from_rest);
     scene->taut = calloc(n, sizeof *scene->taut);
     scene->can_stick = calloc(n, sizeof *scene->can_stick);
     scene->extremum_armed = calloc(n, sizeof *scene->extremum_armed);
-    scene->slot = calloc(n, sizeof *scene->slot);
-    scene->state_slot = calloc(n, sizeof *scene->state_slot);
-    scene->active = calloc(n, sizeof *scene->active);
-    scene->active_mass = calloc(n, sizeof *scene->active_mass);
-    scene->differential_id = calloc(2 * n + model->n_friction_state + 2, sizeof *scene->differential_id);
-    scene->stateful = calloc(n, sizeof *scene->stateful);
+    scene->slot = malloc(n * sizeof *scene->slot);
+    scene->state_slot = malloc(n * sizeof *scene->state_slot);
+    scene->island_of = malloc(n * sizeof *scene->island_of);
     scene->left = calloc(n, sizeof *scene->left);
     scene->right = calloc(n, sizeof *scene->right);
-    scene->root_direction = calloc(n * scene->roots_per_block, sizeof *scene->root_direction);
     if (!scene->mode || !scene->x_ref || !scene->x || !scene->v || !scene->state ||
-        !scene->normal || !scene->t_switch || !scene->from_rest || !scene->taut || !scene->can_stick || !scene->extremum_armed || !scene->slot ||
-        !scene->state_slot || !scene->active || !scene->active_mass || !scene->differential_id || !scene->stateful || !scene->left ||
-        !scene->right || !scene->root_direction) {
+        !scene->state_time || !scene->normal || !scene->t_switch || !scene->from_rest ||
+        !scene->taut || !scene->can_stick || !scene->extremum_armed || !scene->slot ||
+        !scene->state_slot || !scene->island_of || !scene->left || !scene->right) {
         bk_scene_free(scene);
         return -1;
     }
@@ -64,11 +49,14 @@ int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
         scene->can_stick[i] = (b->law->flags & BK_FRICTION_STATIC_THRESHOLD) != 0;
         scene->x[i] = scene->x_ref[i] = b->x_init;
         scene->v[i] = b->v_init;
+        scene->slot[i] = scene->state_slot[i] = BK_NO_SLOT;
+        scene->island_of[i] = BK_NO_ISLAND;
+        scene->taut[i] = 1;
         bk_model_neighbours(model, i, &scene->left[i], &scene->right[i]);
-        if (b->law->n_state > 0) {
-            scene->stateful[scene->n_stateful++] = i;
+        if (b->law->n_state > 0)
             b->law->state_init(b->friction_params, &scene->state[b->state_offset]);
-        }
+        if (b->law->n_state > scene->max_block_state)
+            scene->max_block_state = b->law->n_state;
     }
     return 0;
 }
@@ -80,6 +68,7 @@ void bk_scene_free(bk_scene *scene)
     free(scene->x);
     free(scene->v);
     free(scene->state);
+    free(scene->state_time);
     free(scene->normal);
     free(scene->t_switch);
     free(scene->from_rest);
@@ -88,408 +77,16 @@ void bk_scene_free(bk_scene *scene)
     free(scene->extremum_armed);
     free(scene->slot);
     free(scene->state_slot);
-    free(scene->active);
-    free(scene->active_mass);
-    free(scene->differential_id);
-    free(scene->stateful);
+    free(scene->island_of);
     free(scene->left);
     free(scene->right);
-    free(scene->root_direction);
     memset(scene, 0, sizeof *scene);
 }
 
-/* Position of block j given the integrated vector (stuck blocks sit at x_ref). */
-static inline double position(const bk_scene *scene, const double *y, long j)
-{
-    if (j < 0)
-        return 0.0; /* a fixed wall */
-    size_t s = scene->slot[j];
-    return s == NO_SLOT ? scene->x_ref[j] : scene->x_ref[j] + y[s];
-}
-
-/* Driver-spring force with the spring's taut/slack state frozen since the restart. */
-static inline double driver_force(const bk_scene *scene, size_t i, double x_i, double driver_pos)
-{
-    if (scene->model->spring == BK_SPRING_TENSION_ONLY && !scene->taut[i])
-        return 0.0;
-    return scene->model->blocks[i].driver_stiffness * (driver_pos - x_i);
-}
-
-static inline double coupling_force(const bk_scene *scene, const double *y, size_t i, double x_i)
-{
-    double kc = scene->model->coupling_stiffness;
-    if (kc == 0.0)
-        return 0.0;
-    double force = 0.0;
-    if (scene->left[i] != -1)
-        force += kc * (position(scene, y, scene->left[i]) - x_i);
-    if (scene->right[i] != -1)
-        force += kc * (position(scene, y, scene->right[i]) - x_i);
-    return force;
-}
-
-static inline const double *block_state(const bk_scene *scene, const double *y, size_t i)
+static const double *stored_state(const bk_scene *scene, size_t i)
 {
     const bk_block *b = &scene->model->blocks[i];
-    if (b->law->n_state == 0)
-        return NULL;
-    return y ? &y[scene->state_slot[i]] : &scene->state[b->state_offset];
-}
-
-void bk_scene_restart(bk_scene *scene, double t, double *y)
-{
-    const bk_model *model = scene->model;
-    size_t n = scene->n, next = 0, R = scene->roots_per_block;
-    size_t max_state = 0;
-    scene->n_active = 0;
-    scene->stuck_taut_stiffness = 0.0;
-    scene->stuck_force_ref = 0.0;
-    double driver_pos = bk_driver_position(&model->driver, t);
-    for (size_t i = 0; i < n; ++i) {
-        const bk_block *b = &model->blocks[i];
-        scene->x_ref[i] = scene->x[i];
-        int dir = bk_mode_direction((bk_mode)scene->mode[i]);
-        double extension = driver_pos - scene->x[i];
-        /* At the kink itself the spring is taut if the driver is pulling away. */
-        scene->taut[i] = model->spring == BK_SPRING_LINEAR || extension > 0.0 ||
-                         (extension == 0.0 &&
-                          bk_driver_velocity(&model->driver, t) - (dir != 0 ? scene->v[i] : 0.0) > 0.0);
-        if (dir != 0) {
-            scene->slot[i] = next;
-            scene->active_mass[scene->n_active] = b->mass;
-            scene->active[scene->n_active++] = i;
-            y[next] = 0.0;
-            y[next + 1] = scene->v[i];
-            scene->differential_id[next] = scene->differential_id[next + 1] = 1.0;
-            next += 2;
-        } else {
-            scene->v[i] = 0.0;
-            scene->slot[i] = scene->full_layout ? next : NO_SLOT;
-            if (scene->full_layout) {
-                /* Consistent as it stands: v = 0 satisfies the constraint, xi' = v = 0. */
-                y[next] = y[next + 1] = 0.0;
-                scene->differential_id[next] = 1.0;
-                scene->differential_id[next + 1] = 0.0;
-                next += 2;
-            }
-            if (scene->taut[i]) {
-                scene->stuck_taut_stiffness += b->driver_stiffness;
-                scene->stuck_force_ref += b->driver_stiffness * extension;
-            }
-        }
-        size_t ns = b->law->n_state;
-        if (ns > 0) {
-            scene->state_slot[i] = next;
-            memcpy(&y[next], &scene->state[b->state_offset], ns * sizeof *y);
-            for (size_t j = 0; j < ns; ++j)
-                scene->differential_id[next + j] = 1.0;
-            next += ns;
-            if (ns > max_state)
-                max_state = ns;
-        }
-        scene->root_direction[R * i + BK_ROOT_MAIN] = scene->can_stick[i] ? -1 : 0;
-        scene->root_direction[R * i + BK_ROOT_EXTREMUM] = dir != 0 && scene->can_stick[i] ? +1 : 0;
-        if (R > 2)
-            scene->root_direction[R * i + BK_ROOT_SLACK] = 0;
-    }
-    y[next] = 0.0;     /* driver work since t */
-    y[next + 1] = 0.0; /* dissipation since t */
-    scene->differential_id[next] = scene->differential_id[next + 1] = 1.0;
-    scene->n_y = next + 2;
-    scene->half_bandwidth = 3 + max_state;
-    scene->t_ref = t;
-    scene->work_ref = scene->work;
-    scene->dissipation_ref = scene->dissipation;
-    for (size_t k = 0; k < scene->n_active; ++k) {
-        size_t i = scene->active[k];
-        if (scene->from_rest[i] && scene->t_switch[i] == t)
-            scene->extremum_armed[i] = 0;
-    }
-    bk_scene_arm(scene, t, y);
-}
-
-void bk_scene_tolerances(const bk_scene *scene, double atol_x, double atol_v, double atol_state,
-                         double atol_energy, double *atol)
-{
-    for (size_t i = 0; i < scene->n; ++i) {
-        size_t s = scene->slot[i];
-        if (s == NO_SLOT)
-            continue;
-        atol[s] = atol_x;
-        atol[s + 1] = atol_v;
-    }
-    for (size_t k = 0; k < scene->n_stateful; ++k) {
-        size_t i = scene->stateful[k];
-        for (size_t j = 0; j < scene->model->blocks[i].law->n_state; ++j)
-            atol[scene->state_slot[i] + j] = atol_state;
-    }
-    atol[scene->n_y - 2] = atol_energy;
-    atol[scene->n_y - 1] = atol_energy;
-}
-
-void bk_scene_unpack(bk_scene *scene, double t, const double *y)
-{
-    (void)t;
-    const bk_model *model = scene->model;
-    for (size_t i = 0; i < scene->n; ++i) {
-        size_t s = scene->slot[i];
-        if (s == NO_SLOT) {
-            scene->x[i] = scene->x_ref[i];
-            scene->v[i] = 0.0;
-        } else {
-            /* In the full layout a stuck block too reports what the integrator holds. */
-            scene->x[i] = scene->x_ref[i] + y[s];
-            scene->v[i] = y[s + 1];
-            /* A block that cannot stick reports the way it moves (its law is odd in v). */
-            if (!scene->can_stick[i] && scene->v[i] != 0.0)
-                scene->mode[i] = (int8_t)(scene->v[i] > 0.0 ? BK_MODE_SLIP_POS : BK_MODE_SLIP_NEG);
-        }
-    }
-    for (size_t k = 0; k < scene->n_stateful; ++k) {
-        size_t i = scene->stateful[k];
-        const bk_block *b = &model->blocks[i];
-        memcpy(&scene->state[b->state_offset], &y[scene->state_slot[i]],
-               b->law->n_state * sizeof *y);
-    }
-    scene->work = scene->work_ref + y[scene->n_y - 2];
-    scene->dissipation = scene->dissipation_ref + y[scene->n_y - 1];
-}
-
-/* The right-hand side, whole (f_implicit NULL) or split: the friction terms (the
- * velocity rows' -s F / m, the state rates) into f_implicit and the rest into ydot. */
-static void rhs_parts(const bk_scene *scene, double t, const double *y, double *ydot, double *f_implicit)
-{
-    const bk_model *model = scene->model;
-    double driver_pos = bk_driver_position(&model->driver, t);
-    double driver_disp = bk_driver_displacement(&model->driver, scene->t_ref, t);
-    double driver_force_sum = scene->stuck_force_ref + scene->stuck_taut_stiffness * driver_disp;
-    double dissipation_rate = 0.0;
-    double *state_rates = f_implicit ? f_implicit : ydot;
-    if (f_implicit)
-        memset(f_implicit, 0, scene->n_y * sizeof *f_implicit);
-    for (size_t k = 0; k < scene->n_active; ++k) {
-        size_t i = scene->active[k], s = scene->slot[i];
-        const bk_block *b = &model->blocks[i];
-        double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
-        double dir = (double)scene->mode[i];
-        double spring = driver_force(scene, i, x_i, driver_pos);
-        double applied = spring + coupling_force(scene, y, i, x_i);
-        double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
-                                                block_state(scene, y, i));
-        ydot[s] = v_i;
-        if (f_implicit) {
-            ydot[s + 1] = applied / b->mass;
-            f_implicit[s + 1] = -dir * friction / b->mass;
-        } else {
-            ydot[s + 1] = (applied - dir * friction) / b->mass;
-        }
-        driver_force_sum += spring;
-        dissipation_rate += dir * friction * v_i;
-    }
-    if (scene->full_layout)
-        for (size_t i = 0; i < scene->n; ++i)
-            if (bk_scene_stuck(scene, i)) {
-                size_t s = scene->slot[i];
-                ydot[s] = y[s + 1];       /* xi' = v */
-                ydot[s + 1] = -y[s + 1]; /* 0 = -v, algebraic */
-            }
-    for (size_t k = 0; k < scene->n_stateful; ++k) {
-        size_t i = scene->stateful[k];
-        const bk_block *b = &model->blocks[i];
-        /* A stuck block's state ages at rest.  In the full layout its v is 0 by the
-         * constraint anyway, and |v| has no derivative there for the Jacobian. */
-        double speed = bk_scene_stuck(scene, i) ? 0.0 : fabs(y[scene->slot[i] + 1]);
-        b->law->state_rate(b->friction_params, speed, &y[scene->state_slot[i]],
-                           &state_rates[scene->state_slot[i]]);
-        if (f_implicit)
-            for (size_t j = 0; j < b->law->n_state; ++j)
-                ydot[scene->state_slot[i] + j] = 0.0;
-    }
-    ydot[scene->n_y - 2] = bk_driver_velocity(&model->driver, t) * driver_force_sum;
-    ydot[scene->n_y - 1] = dissipation_rate;
-}
-
-int bk_scene_rhs(double t, const double *y, double *ydot, void *user)
-{
-    rhs_parts(user, t, y, ydot, NULL);
-    return 0;
-}
-
-int bk_scene_rhs_split(double t, const double *y, double *f_explicit, double *f_implicit, void *user)
-{
-    rhs_parts(user, t, y, f_explicit, f_implicit);
-    return 0;
-}
-
-/* d(sliding force)/d(slip rate) and d/d(state) of block i (N s/m, N per state unit). */
-static void friction_derivatives(const bk_scene *scene, size_t i, double slip_rate, const double *state,
-                                 double *d_rate, double *d_state)
-{
-    const bk_block *b = &scene->model->blocks[i];
-    const bk_friction_law *law = b->law;
-    double h = 1e-6 * fmax(fabs(slip_rate), 1e-9);
-    *d_rate = (law->sliding_force(b->friction_params, scene->normal[i], slip_rate + h, state) -
-               law->sliding_force(b->friction_params, scene->normal[i], slip_rate - h, state)) /
-              (2.0 * h);
-    if (law->n_state == 0) {
-        *d_state = 0.0;
-        return;
-    }
-    double shifted[BK_FRICTION_MAX_STATE];
-    double hs = 1e-6 * fmax(fabs(state[0]), 1e-12);
-    shifted[0] = state[0] + hs;
-    double up = law->sliding_force(b->friction_params, scene->normal[i], slip_rate, shifted);
-    shifted[0] = state[0] - hs;
-    double down = law->sliding_force(b->friction_params, scene->normal[i], slip_rate, shifted);
-    *d_state = (up - down) / (2.0 * hs);
-}
-
-/* The Jacobian of the whole right-hand side, or (friction_only) of its friction part. */
-static void jacobian_parts(const bk_scene *scene, double t, const double *y, int friction_only,
-                           void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
-{
-    const bk_model *model = scene->model;
-    double kc = model->coupling_stiffness;
-    double speed = bk_driver_velocity(&model->driver, t);
-    size_t work_row = scene->n_y - 2, dissipation_row = scene->n_y - 1;
-    for (size_t k = 0; k < scene->n_active; ++k) {
-        size_t i = scene->active[k], s = scene->slot[i];
-        const bk_block *b = &model->blocks[i];
-        double dir = (double)scene->mode[i], v_i = y[s + 1], m = b->mass;
-        double spring = model->spring == BK_SPRING_TENSION_ONLY && !scene->taut[i] ? 0.0 : b->driver_stiffness;
-        if (!friction_only) {
-            put(matrix, s, s + 1, 1.0); /* xi' = v */
-            /* Springs: the block's own stiffness, and its slipping partners. */
-            put(matrix, s + 1, s, -(spring + kc * bk_model_coupling_count(model, i)) / m);
-            const long partners[2] = {scene->left[i], scene->right[i]};
-            for (size_t p = 0; p < 2 && kc > 0.0; ++p)
-                if (partners[p] >= 0 && scene->slot[partners[p]] != NO_SLOT)
-                    put(matrix, s + 1, scene->slot[partners[p]], kc / m);
-        }
-        /* Friction: -dir F(dir v, state) / m. */
-        const double *state = block_state(scene, y, i);
-        double d_rate, d_state;
-        friction_derivatives(scene, i, dir * v_i, state, &d_rate, &d_state);
-        put(matrix, s + 1, s + 1, -d_rate / m);
-        if (state)
-            put(matrix, s + 1, scene->state_slot[i], -dir * d_state / m);
-        if (friction_only)
-            continue;
-        /* Energy rates: driver power V k (D - x), friction power dir F v. */
-        double force = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i, state);
-        put(matrix, work_row, s, -speed * spring);
-        put(matrix, dissipation_row, s + 1, dir * force + v_i * d_rate);
-        if (state)
-            put(matrix, dissipation_row, scene->state_slot[i], dir * v_i * d_state);
-    }
-    if (scene->full_layout && !friction_only)
-        for (size_t i = 0; i < scene->n; ++i)
-            if (bk_scene_stuck(scene, i)) {
-                size_t s = scene->slot[i];
-                put(matrix, s, s + 1, 1.0);
-                put(matrix, s + 1, s + 1, -1.0);
-            }
-    /* State equations: d(rate)/d(state) and, while slipping, d(rate)/dv. */
-    for (size_t k = 0; k < scene->n_stateful; ++k) {
-        size_t i = scene->stateful[k], q = scene->state_slot[i], s = scene->slot[i];
-        const bk_block *b = &model->blocks[i];
-        int slipping = !bk_scene_stuck(scene, i);
-        double v_i = slipping ? y[s + 1] : 0.0, spd = fabs(v_i);
-        double st[BK_FRICTION_MAX_STATE], up[BK_FRICTION_MAX_STATE], down[BK_FRICTION_MAX_STATE];
-        double hs = 1e-6 * fmax(fabs(y[q]), 1e-12);
-        st[0] = y[q] + hs;
-        b->law->state_rate(b->friction_params, spd, st, up);
-        st[0] = y[q] - hs;
-        b->law->state_rate(b->friction_params, spd, st, down);
-        put(matrix, q, q, (up[0] - down[0]) / (2.0 * hs));
-        if (slipping) {
-            double hv = 1e-6 * fmax(spd, 1e-9);
-            b->law->state_rate(b->friction_params, spd + hv, &y[q], up);
-            b->law->state_rate(b->friction_params, fmax(spd - hv, 0.0), &y[q], down);
-            double d_speed = (up[0] - down[0]) / (spd + hv - fmax(spd - hv, 0.0));
-            put(matrix, q, s + 1, v_i >= 0.0 ? d_speed : -d_speed);
-        }
-    }
-}
-
-int bk_scene_jacobian(double t, const double *y, void *user,
-                      void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
-{
-    jacobian_parts(user, t, y, 0, put, matrix);
-    return 0;
-}
-
-int bk_scene_jacobian_implicit(double t, const double *y, void *user,
-                               void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
-{
-    jacobian_parts(user, t, y, 1, put, matrix);
-    return 0;
-}
-
-int bk_scene_roots(double t, const double *y, double *g, void *user)
-{
-    const bk_scene *scene = user;
-    const bk_model *model = scene->model;
-    size_t R = scene->roots_per_block;
-    double driver_pos = bk_driver_position(&model->driver, t);
-    for (size_t i = 0; i < scene->n; ++i) {
-        const bk_block *b = &model->blocks[i];
-        double *gi = &g[R * i];
-        double x_i = position(scene, y, (long)i);
-        double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(scene, y, i, x_i);
-        const double *state = block_state(scene, y, i);
-        size_t s = scene->slot[i];
-        if (!scene->can_stick[i]) {
-            gi[BK_ROOT_MAIN] = 1.0; /* smooth through v = 0: nothing to locate */
-            gi[BK_ROOT_EXTREMUM] = 1.0;
-        } else if (bk_scene_stuck(scene, i)) {
-            gi[BK_ROOT_MAIN] = b->law->static_threshold(b->friction_params, scene->normal[i], state) -
-                               fabs(applied);
-            gi[BK_ROOT_EXTREMUM] = 1.0;
-        } else {
-            double dir = (double)scene->mode[i];
-            double v_i = y[s + 1];
-            double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i, state);
-            double slip_accel = dir * (applied - dir * friction) / b->mass;
-            double since = t - scene->t_switch[i];
-            if (!scene->from_rest[i])
-                gi[BK_ROOT_MAIN] = dir * v_i;
-            else
-                gi[BK_ROOT_MAIN] = since > 0.0 ? dir * v_i / since : slip_accel;
-            gi[BK_ROOT_EXTREMUM] = scene->detect_extrema && scene->extremum_armed[i] ? slip_accel : 1.0;
-        }
-        if (R > 2)
-            gi[BK_ROOT_SLACK] = driver_pos - x_i;
-    }
-    return 0;
-}
-
-double bk_scene_slip_acceleration(const bk_scene *scene, size_t i, double t, const double *y)
-{
-    const bk_block *b = &scene->model->blocks[i];
-    size_t s = scene->slot[i];
-    double driver_pos = bk_driver_position(&scene->model->driver, t);
-    double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
-    double dir = (double)scene->mode[i];
-    double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(scene, y, i, x_i);
-    double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
-                                            block_state(scene, y, i));
-    return dir * (applied - dir * friction) / b->mass;
-}
-
-void bk_scene_arm(bk_scene *scene, double t, const double *y)
-{
-    for (size_t k = 0; k < scene->n_active; ++k) {
-        size_t i = scene->active[k];
-        if (scene->extremum_armed[i] || !scene->can_stick[i])
-            continue;
-        const bk_block *b = &scene->model->blocks[i];
-        double threshold = b->law->static_threshold(b->friction_params, scene->normal[i],
-                                                    block_state(scene, y, i));
-        /* Clearly negative: well beyond the rounding of (force - friction) / m. */
-        if (bk_scene_slip_acceleration(scene, i, t, y) < -1e-9 * threshold / b->mass)
-            scene->extremum_armed[i] = 1;
-    }
+    return b->law->n_state ? &scene->state[b->state_offset] : NULL;
 }
 
 double bk_scene_applied_force(const bk_scene *scene, size_t i, double driver_pos)
@@ -500,14 +97,14 @@ double bk_scene_applied_force(const bk_scene *scene, size_t i, double driver_pos
 double bk_scene_static_threshold(const bk_scene *scene, size_t i)
 {
     const bk_block *b = &scene->model->blocks[i];
-    return b->law->static_threshold(b->friction_params, scene->normal[i], block_state(scene, NULL, i));
+    return b->law->static_threshold(b->friction_params, scene->normal[i], stored_state(scene, i));
 }
 
 double bk_scene_sliding_force(const bk_scene *scene, size_t i, double slip_rate)
 {
     const bk_block *b = &scene->model->blocks[i];
     return b->law->sliding_force(b->friction_params, scene->normal[i], slip_rate,
-                                 block_state(scene, NULL, i));
+                                 stored_state(scene, i));
 }
 
 double bk_scene_friction(const bk_scene *scene, size_t i, double driver_pos)
@@ -516,4 +113,35 @@ double bk_scene_friction(const bk_scene *scene, size_t i, double driver_pos)
     if (dir == 0)
         return bk_scene_applied_force(scene, i, driver_pos);
     return dir * bk_scene_sliding_force(scene, i, dir * scene->v[i]);
+}
+
+size_t bk_scene_state_at_rest(const bk_scene *scene, size_t i, double t, double *out)
+{
+    const bk_block *b = &scene->model->blocks[i];
+    size_t ns = b->law->n_state;
+    if (ns == 0)
+        return 0;
+    memcpy(out, &scene->state[b->state_offset], ns * sizeof *out);
+    double dt = t - scene->state_time[i];
+    if (dt > 0.0)
+        b->law->state_advance(b->friction_params, 0.0, dt, out);
+    return ns;
+}
+
+void bk_scene_age(bk_scene *scene, size_t i, double t)
+{
+    const bk_block *b = &scene->model->blocks[i];
+    if (b->law->n_state > 0 && t > scene->state_time[i])
+        b->law->state_advance(b->friction_params, 0.0, t - scene->state_time[i],
+                              &scene->state[b->state_offset]);
+    scene->state_time[i] = t;
+}
+
+double bk_scene_driver_spring_energy(const bk_scene *scene, size_t i, double driver_pos)
+{
+    const bk_model *model = scene->model;
+    double extension = driver_pos - scene->x[i];
+    if (model->spring == BK_SPRING_TENSION_ONLY && extension < 0.0)
+        return 0.0;
+    return 0.5 * model->blocks[i].driver_stiffness * extension * extension;
 }

@@ -1,15 +1,24 @@
-/* Internal: the chain's state during a run and the compact ODE the integrator sees.
+/* Internal: the chain's state during a run, and the islands the integrator sees.
  *
- * Only slipping blocks carry dynamics.  Between two (re)starts the integrated vector is,
- * in chain order, per block: [xi, v] if slipping (xi = x - x_ref, the slip since the
- * restart, so the integrator's error scales with the slip, not the absolute position),
- * then the block's friction state if its law has any; and last two energy increments since
- * the restart: driver work and frictional dissipation.  Stuck blocks keep x = x_ref, v = 0.
+ * Stuck blocks split the slipping ones into independent groups.  An island is a contiguous
+ * run of blocks (cyclic on a periodic chain): slipping stretches that only one stuck block
+ * separates, together with the stuck blocks next to them.  A stuck block's breakaway then
+ * depends on one island only, and a stuck block next to no slipping block ("quiet") on
+ * nothing that moves: its failure time follows in closed form from the driver's motion and
+ * needs no integrator at all.  Each island is integrated on its own, so the work of a step
+ * or an event is proportional to the island, not to the chain.
  *
- * The full layout (full_layout set; only for a back-end that asks, IDA) keeps [xi, v] of
- * stuck blocks too, as rows xi' = v (differential) and 0 = -v (algebraic: the residual
- * diag(id) y' - f reads v), so the vector's size never changes.  It costs 2 unknowns per
- * stuck block, so the other back-ends keep the compact ODE: the DAE is IDA's choice. */
+ * An island's integrated vector is, in chain order, per block: [xi, v] if slipping (xi =
+ * x - x_ref, the slip since the island's restart, so the integrator's error scales with the
+ * slip, not the absolute position), then the block's friction state if its law has any; and
+ * last two energy increments since the restart: the driver work on its slipping blocks and
+ * their frictional dissipation.  Stuck blocks keep x = x_ref, v = 0.
+ *
+ * The full layout (full_layout set; only for a back-end that asks, IDA) keeps [xi, v] of an
+ * island's stuck blocks too, as rows xi' = v (differential) and 0 = -v (algebraic: the
+ * residual diag(id) y' - f reads v), so the vector's size never changes between restarts
+ * of one island.  It costs 2 unknowns per stuck block, so the other back-ends keep the
+ * compact ODE: the DAE is IDA's choice. */
 #ifndef BKSIM_SCENE_H
 #define BKSIM_SCENE_H
 
@@ -23,14 +32,19 @@
  * 2 = driver spring going slack/taut (tension-only springs only). */
 enum { BK_ROOT_MAIN = 0, BK_ROOT_EXTREMUM = 1, BK_ROOT_SLACK = 2 };
 
+#define BK_NO_SLOT SIZE_MAX
+#define BK_NO_ISLAND SIZE_MAX
+
 typedef struct bk_scene {
     const bk_model *model;
     size_t n;                /* blocks */
     int8_t *mode;            /* bk_mode per block */
-    double *x_ref;           /* m, positions at the last restart (stuck blocks: their position) */
+    double *x_ref;           /* m, positions at the island's last restart (stuck blocks: their position) */
     double *x;               /* m, current positions (unpacked) */
     double *v;               /* m/s, current velocities (unpacked) */
-    double *state;           /* friction states, model->n_friction_state */
+    double *state;           /* friction states, model->n_friction_state; a quiet block's
+                                refer to state_time */
+    double *state_time;      /* s, per block: when its stored friction state was current */
     double *normal;          /* N, per block */
     double *t_switch;        /* s, when each block last started slipping from rest */
     uint8_t *from_rest;      /* 1 when the current slip started at zero velocity at t_switch */
@@ -45,82 +59,109 @@ typedef struct bk_scene {
                                 clearly negative and disarmed at a slip start and after each
                                 minimum: it never starts at or hovers around zero (a slip
                                 that starts with zero acceleration, steady sliding). */
-
-    /* Layout, rebuilt at every restart. */
-    int full_layout;         /* stuck blocks stay in y (see above); set before the first restart */
-    size_t *slot;            /* per block: index of xi in y, or SIZE_MAX when stuck (compact) */
-    size_t *state_slot;      /* per block: index of its first friction state in y */
-    size_t n_y;              /* length of y */
-    size_t n_active;         /* slipping blocks */
-    size_t half_bandwidth;   /* Jacobian half bandwidth of the layout */
-    double t_ref;            /* s, time of the last restart */
-    double work_ref;         /* J, driver work up to t_ref */
-    double dissipation_ref;  /* J, dissipation up to t_ref */
-    double stuck_taut_stiffness; /* N/m, sum of k_i over stuck blocks with a taut driver spring */
-    double stuck_force_ref;      /* N, their driver-spring forces at t_ref */
-    size_t *active;          /* the n_active slipping blocks, chain order */
-    double *active_mass;     /* kg, their masses in the same order */
-    double *differential_id; /* n_y: 1 for a differential component, 0 for an algebraic one */
-    int affine;              /* the compact ODE is affine in y and t (see bk_ode_problem) */
-    size_t *stateful;        /* blocks whose law carries state */
-    size_t n_stateful;
+    int full_layout;         /* islands keep their stuck blocks in y (see above) */
+    int affine;              /* every law Coulomb-like: islands' ODEs are affine in y and t */
+    size_t *slot;            /* per block: index of xi in its island's y, or BK_NO_SLOT */
+    size_t *state_slot;      /* per block: index of its first friction state in its island's y */
+    size_t *island_of;       /* per block: its island, or BK_NO_ISLAND (quiet) */
     long *left, *right;      /* coupling partners (bk_model_neighbours) */
-
-    /* Unpacked energies at the current time. */
-    double work;             /* J */
-    double dissipation;      /* J */
-
     size_t roots_per_block;  /* 2, or 3 with tension-only springs */
-    int *root_direction;     /* n * roots_per_block */
+    size_t max_block_state;  /* friction states of the most stateful block */
 } bk_scene;
 
 int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema);
+void bk_scene_free(bk_scene *scene);
 /* Block i is stuck in the current layout: a mode changes only at an event, which a restart
  * follows (a block that cannot stick only flips its slip direction). */
 static inline int bk_scene_stuck(const bk_scene *scene, size_t i)
 {
     return scene->mode[i] == BK_MODE_STICK;
 }
-void bk_scene_free(bk_scene *scene);
-
-/* Rebuild the layout for the current modes at time t (x, v, state, work, dissipation hold
- * the state there) and write the integrator's starting vector into y (size n_y). */
-void bk_scene_restart(bk_scene *scene, double t, double *y);
-/* Per-component absolute tolerances for the current layout. */
-void bk_scene_tolerances(const bk_scene *scene, double atol_x, double atol_v, double atol_state,
-                         double atol_energy, double *atol);
-/* Arm the slip-rate minimum roots of blocks now clearly decelerating (call at step ends;
- * a disarmed root reads as +1 and its direction is rising-only, so arming cannot fake a
- * crossing). */
-void bk_scene_arm(bk_scene *scene, double t, const double *y);
-/* Slip acceleration s a of slipping block i for the integrated vector y (m/s^2). */
-double bk_scene_slip_acceleration(const bk_scene *scene, size_t i, double t, const double *y);
-/* Fill x, v, state, work, dissipation from the integrated vector y at time t. */
-void bk_scene_unpack(bk_scene *scene, double t, const double *y);
-
-/* The ODE right-hand side and root functions for the current layout (bk_ode_problem); in
- * the full layout f of the semi-explicit DAE, a stuck block's velocity row being -v. */
-int bk_scene_rhs(double t, const double *y, double *ydot, void *scene);
-/* The exact Jacobian of bk_scene_rhs (see bk_ode_problem.jacobian); friction-law
- * derivatives by central differences. */
-int bk_scene_jacobian(double t, const double *y, void *scene,
-                      void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix);
-int bk_scene_roots(double t, const double *y, double *g, void *scene);
-/* The IMEX split of bk_scene_rhs (bk_ode_problem.rhs_split): friction implicit, the rest
- * explicit; f_explicit + f_implicit = bk_scene_rhs. */
-int bk_scene_rhs_split(double t, const double *y, double *f_explicit, double *f_implicit, void *scene);
-/* d f_implicit / dy. */
-int bk_scene_jacobian_implicit(double t, const double *y, void *scene,
-                               void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix);
 
 /* Applied (spring) force on block i with the unpacked positions at driver position D. */
 double bk_scene_applied_force(const bk_scene *scene, size_t i, double driver_pos);
-/* Static threshold of block i (N) with its current friction state; +inf-free. */
+/* Static threshold of block i (N) with its stored friction state. */
 double bk_scene_static_threshold(const bk_scene *scene, size_t i);
 /* Sliding force magnitude of block i at slip rate s*v (N). */
 double bk_scene_sliding_force(const bk_scene *scene, size_t i, double slip_rate);
 /* Shear force the interface carries at block i (N, positive when it resists +x motion):
  * the applied force when stuck, s * sliding force when slipping. */
 double bk_scene_friction(const bk_scene *scene, size_t i, double driver_pos);
+/* The friction state of block i at rest, aged from state_time to t (at most
+ * BK_FRICTION_MAX_STATE values into out; stored state untouched).  A block without state: 0. */
+size_t bk_scene_state_at_rest(const bk_scene *scene, size_t i, double t, double *out);
+/* Age a resting block's stored state to t (state_time = t). */
+void bk_scene_age(bk_scene *scene, size_t i, double t);
+/* Energy in block i's driver spring at driver position D (J): what the driver's work on a
+ * stuck block adds up to. */
+double bk_scene_driver_spring_energy(const bk_scene *scene, size_t i, double driver_pos);
+
+/* An island: blocks start, start + 1, ..., start + len - 1 of the chain (mod n). */
+typedef struct bk_island {
+    bk_scene *scene;
+    size_t id;               /* index in the run's island table */
+    size_t start, len;
+    /* Layout, rebuilt at every restart. */
+    size_t n_y;              /* length of y */
+    size_t n_active;         /* slipping blocks */
+    size_t half_bandwidth;   /* Jacobian half bandwidth of the layout */
+    double t_ref;            /* s, time of the last restart */
+    size_t *active;          /* the n_active slipping blocks, chain order from start */
+    double *active_mass;     /* kg, their masses in the same order */
+    size_t *stateful;        /* blocks whose law carries state */
+    size_t n_stateful;
+    double *differential_id; /* n_y: 1 for a differential component, 0 for an algebraic one */
+    int *root_direction;     /* roots_per_block * len */
+    int affine;              /* the compact ODE is affine in y and t (see bk_ode_problem) */
+    size_t capacity;         /* blocks the arrays above have room for */
+} bk_island;
+
+static inline size_t bk_island_block(const bk_island *island, size_t k)
+{
+    size_t i = island->start + k;
+    return i < island->scene->n ? i : i - island->scene->n;
+}
+static inline size_t bk_island_n_roots(const bk_island *island)
+{
+    return island->scene->roots_per_block * island->len;
+}
+/* Longest y an island of len blocks can need. */
+size_t bk_island_max_y(const bk_scene *scene, size_t len);
+
+/* Room for an island of len blocks (arrays grow, never shrink); -1 when out of memory. */
+int bk_island_reserve(bk_island *island, size_t len);
+void bk_island_free(bk_island *island);
+/* Rebuild the layout for the current modes at time t (x, v and state of the island's blocks
+ * hold the state there) and write the integrator's starting vector into y (size n_y). */
+void bk_island_restart(bk_island *island, double t, double *y);
+/* Per-component absolute tolerances for the current layout. */
+void bk_island_tolerances(const bk_island *island, double atol_x, double atol_v, double atol_state,
+                          double atol_energy, double *atol);
+/* Arm the slip-rate minimum roots of blocks now clearly decelerating (call at step ends;
+ * a disarmed root reads as +1 and its direction is rising-only, so arming cannot fake a
+ * crossing). */
+void bk_island_arm(bk_island *island, double t, const double *y);
+/* Slip acceleration s a of slipping block i for the integrated vector y (m/s^2). */
+double bk_island_slip_acceleration(const bk_island *island, size_t i, double t, const double *y);
+/* Fill x, v and state of the island's blocks from y at time t; *work and *dissipation (may
+ * be NULL) receive the energy increments since the restart (J). */
+void bk_island_unpack(bk_island *island, double t, const double *y, double *work,
+                      double *dissipation);
+
+/* The ODE right-hand side and root functions of an island (bk_ode_problem, user = island);
+ * in the full layout f of the semi-explicit DAE, a stuck block's velocity row being -v.
+ * Root k belongs to block bk_island_block(island, k / roots_per_block). */
+int bk_island_rhs(double t, const double *y, double *ydot, void *island);
+/* The exact Jacobian of bk_island_rhs (see bk_ode_problem.jacobian); friction-law
+ * derivatives by central differences. */
+int bk_island_jacobian(double t, const double *y, void *island,
+                       void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix);
+int bk_island_roots(double t, const double *y, double *g, void *island);
+/* The IMEX split of bk_island_rhs (bk_ode_problem.rhs_split): friction implicit, the rest
+ * explicit; f_explicit + f_implicit = bk_island_rhs. */
+int bk_island_rhs_split(double t, const double *y, double *f_explicit, double *f_implicit, void *island);
+/* d f_implicit / dy. */
+int bk_island_jacobian_implicit(double t, const double *y, void *island,
+                                void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix);
 
 #endif

@@ -256,18 +256,49 @@ static void test_restart_keeps_all_overrides(void **state)
     assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
 }
 
+/* Rows [0, rows) of dataset name agree bit for bit in files a and b. */
+static void expect_same_rows(const char *a, const char *b, const char *name, size_t rows)
+{
+    double *x, *y;
+    size_t ra, ca, rb, cb;
+    bk_error err;
+    assert_int_equal(bk_h5_read_doubles(a, name, &x, &ra, &ca, &err), BK_OK);
+    assert_int_equal(bk_h5_read_doubles(b, name, &y, &rb, &cb, &err), BK_OK);
+    assert_true(ra >= rows && rb >= rows && ca == cb);
+    if (memcmp(x, y, rows * ca * sizeof *x) != 0)
+        fail_msg("/%s: the rows before the checkpoint changed", name);
+    free(x);
+    free(y);
+}
+
+static int by_time(const void *a, const void *b)
+{
+    const bk_transition *x = a, *y = b;
+    return (x->t > y->t) - (x->t < y->t);
+}
+
 /* A .part written by bksim before the output module was split (tests/data/README.md)
- * verifies, restarts from its newest checkpoint, and ends with exactly the output of an
- * uninterrupted run of the config it stores: the file format is unchanged. */
+ * verifies and restarts from its newest checkpoint: the rows and transitions it holds up to
+ * there are kept as they are, and the run ends with the transitions of an uninterrupted run
+ * of the config it stores, to the method's accuracy (the algorithm has changed since that
+ * version, so not bit for bit: the file format is what holds). */
 static void test_restart_file_of_earlier_version(void **state)
 {
     output_fixture *f = *state;
-    assert_int_equal(copy_file("tests/data/chain3_rs_d9ab1a6.h5.part", part_path(f->path)), 0);
+    const char *fixture = "tests/data/chain3_rs_d9ab1a6.h5.part";
+    assert_int_equal(copy_file(fixture, part_path(f->path)), 0);
     bk_error err = {0};
     assert_int_equal(bk_h5_verify(part_path(f->path), &err), BK_INCOMPLETE);
     double t = 0;
     assert_int_equal(bk_h5_restartable(f->path, &t, &err), 1);
     assert_true(t == 1.0);
+    hid_t file = H5Fopen(fixture, H5F_ACC_RDONLY, H5P_DEFAULT);
+    char slot_name[32];
+    snprintf(slot_name, sizeof slot_name, "checkpoint/%s", newest_slot(fixture));
+    hid_t slot = H5Gopen2(file, slot_name, H5P_DEFAULT);
+    size_t rows = (size_t)attr_llong(slot, "rows"), transition_rows = (size_t)attr_llong(slot, "transition_rows");
+    H5Gclose(slot);
+    H5Fclose(file);
 
     bk_h5_writer *w;
     bk_config *config = NULL;
@@ -285,11 +316,34 @@ static void test_restart_file_of_earlier_version(void **state)
     bk_checkpoint_free(&cp);
     assert_int_equal(bk_h5_writer_finish(w, &stats, &err), BK_OK);
     assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+    static const char *const kept[] = {"time", "x", "v", "friction_state", "mode", "work_driver"};
+    for (size_t k = 0; k < sizeof kept / sizeof *kept; ++k)
+        expect_same_rows(fixture, f->path, kept[k], rows);
 
     char reference[256];
     snprintf(reference, sizeof reference, "%s/reference.h5", f->dir);
     run_into(config, reference, -1, 0);
-    assert_same_output(reference, f->path);
+    bk_transition *restarted, *uninterrupted, *old;
+    size_t n_restarted, n_uninterrupted, n_old;
+    assert_int_equal(bk_h5_read_transitions(f->path, &restarted, &n_restarted, &err), BK_OK);
+    assert_int_equal(bk_h5_read_transitions(reference, &uninterrupted, &n_uninterrupted, &err), BK_OK);
+    assert_int_equal(bk_h5_read_transitions(fixture, &old, &n_old, &err), BK_OK);
+    assert_true(n_old >= transition_rows && n_restarted >= transition_rows);
+    for (size_t k = 0; k < transition_rows; ++k)
+        assert_true(old[k].t == restarted[k].t && old[k].block == restarted[k].block &&
+                    old[k].from == restarted[k].from && old[k].to == restarted[k].to &&
+                    old[k].x == restarted[k].x && old[k].v == restarted[k].v &&
+                    old[k].force == restarted[k].force);
+    /* Blocks 0 and 2 mirror each other: their simultaneous transitions may come out in
+     * either order at rounding level, so the times are compared in time order. */
+    assert_int_equal(n_restarted, n_uninterrupted);
+    qsort(restarted, n_restarted, sizeof *restarted, by_time);
+    qsort(uninterrupted, n_uninterrupted, sizeof *uninterrupted, by_time);
+    for (size_t k = 0; k < n_restarted; ++k)
+        assert_close(restarted[k].t, uninterrupted[k].t, 0, 1e-8); /* rtol 1e-8, t ~ 1 s */
+    free(restarted);
+    free(uninterrupted);
+    free(old);
     bk_config_free(config);
 }
 

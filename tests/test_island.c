@@ -1,6 +1,7 @@
-/* The compact ODE: only slipping blocks are integrated, stateless laws carry no state, and
- * every root function of a block that just switched starts clearly away from zero.  IDA's
- * full layout: stuck blocks stay in, pinned by an algebraic row whose residual is v. */
+/* An island's compact ODE (src/island.c): only slipping blocks are integrated, stateless
+ * laws carry no state, and every root function of a block that just switched starts clearly
+ * away from zero.  IDA's full layout: stuck blocks stay in, pinned by an algebraic row whose
+ * residual is v.  Islands that are part of a chain: blocks outside stay fixed ends. */
 #include <stdint.h>
 #include <stdlib.h>
 
@@ -27,6 +28,14 @@ static bk_model *make_chain(size_t n, bk_spring spring)
     return m;
 }
 
+/* An island over blocks [start, start + len) of the scene's chain. */
+static bk_island island_of(bk_scene *s, size_t id, size_t start, size_t len)
+{
+    bk_island island = {.scene = s, .id = id, .start = start, .len = len};
+    assert_int_equal(bk_island_reserve(&island, len), 0);
+    return island;
+}
+
 static void test_layout(void **state)
 {
     (void)state;
@@ -40,9 +49,10 @@ static void test_layout(void **state)
     s.v[3] = -0.02;
     s.v[0] = 0.5; /* a stuck block's velocity is forced to zero */
     double y[16];
-    bk_scene_restart(&s, 0.3, y);
-    assert_int_equal(s.n_y, 2 * 2 + 2); /* two slipping blocks, plus two energy increments */
-    assert_int_equal(s.n_active, 2);
+    bk_island isl = island_of(&s, 0, 0, 4);
+    bk_island_restart(&isl, 0.3, y);
+    assert_int_equal(isl.n_y, 2 * 2 + 2); /* two slipping blocks, plus two energy increments */
+    assert_int_equal(isl.n_active, 2);
     assert_true(s.slot[0] == SIZE_MAX && s.slot[2] == SIZE_MAX);
     assert_close(y[s.slot[1]], 0.0, 0, 0);
     assert_close(y[s.slot[1] + 1], 0.01, 0, 0);
@@ -50,9 +60,13 @@ static void test_layout(void **state)
     assert_close(s.v[0], 0.0, 0, 0);
     /* Unpacking returns slip since the restart on top of the reference positions. */
     y[s.slot[1]] = 2.5e-5;
-    bk_scene_unpack(&s, 0.31, y);
+    y[isl.n_y - 2] = 0.125;
+    double work = 0.0;
+    bk_island_unpack(&isl, 0.31, y, &work, NULL);
     assert_close(s.x[1], 2.5e-5, 1e-15, 0);
     assert_close(s.x[0], 0.0, 0, 0);
+    assert_close(work, 0.125, 0, 0);
+    bk_island_free(&isl);
     bk_scene_free(&s);
     bk_model_free(m);
 }
@@ -68,10 +82,10 @@ static void test_full_layout(void **state)
     assert_int_equal(bk_scene_init(&compact, m, 1), 0);
     assert_int_equal(bk_scene_init(&full, m, 1), 0);
     full.full_layout = 1;
-    bk_scene *both[2] = {&compact, &full};
+    bk_island islands[2] = {island_of(&compact, 0, 0, 4), island_of(&full, 0, 0, 4)};
     double y[2][16], ydot[2][16], g[2][8], t = 0.3;
     for (size_t k = 0; k < 2; ++k) {
-        bk_scene *s = both[k];
+        bk_scene *s = islands[k].scene;
         s->x[0] = 1e-4;
         s->x[2] = -0.5e-4;
         s->mode[1] = BK_MODE_SLIP_POS;
@@ -79,45 +93,50 @@ static void test_full_layout(void **state)
         s->v[1] = 0.01;
         s->v[3] = -0.02;
         s->v[0] = 0.5; /* a stuck block's velocity is forced to zero */
-        bk_scene_restart(s, t, y[k]);
+        bk_island_restart(&islands[k], t, y[k]);
     }
-    assert_int_equal(full.n_y, 4 * 2 + 2);
-    assert_int_equal(full.n_active, 2);
+    const bk_island *fi = &islands[1], *ci = &islands[0];
+    assert_int_equal(fi->n_y, 4 * 2 + 2);
+    assert_int_equal(fi->n_active, 2);
     for (size_t i = 0; i < 4; ++i) {
         size_t s = full.slot[i];
         assert_true(s != SIZE_MAX);
-        assert_close(full.differential_id[s], 1.0, 0, 0);
-        assert_close(full.differential_id[s + 1], i % 2 == 0 ? 0.0 : 1.0, 0, 0);
+        assert_close(fi->differential_id[s], 1.0, 0, 0);
+        assert_close(fi->differential_id[s + 1], i % 2 == 0 ? 0.0 : 1.0, 0, 0);
     }
-    assert_close(full.differential_id[full.n_y - 2], 1.0, 0, 0);
-    assert_close(full.differential_id[full.n_y - 1], 1.0, 0, 0);
+    assert_close(fi->differential_id[fi->n_y - 2], 1.0, 0, 0);
+    assert_close(fi->differential_id[fi->n_y - 1], 1.0, 0, 0);
     size_t stuck = full.slot[2];
     assert_close(y[1][stuck], 0.0, 0, 0);
     assert_close(y[1][stuck + 1], 0.0, 0, 0);
     for (size_t k = 0; k < 2; ++k) {
-        bk_scene_rhs(t + 1e-3, y[k], ydot[k], both[k]);
-        bk_scene_roots(t + 1e-3, y[k], g[k], both[k]);
+        bk_island_rhs(t + 1e-3, y[k], ydot[k], &islands[k]);
+        bk_island_roots(t + 1e-3, y[k], g[k], &islands[k]);
     }
     for (size_t i = 1; i < 4; i += 2)
         for (size_t c = 0; c < 2; ++c)
             assert_close(ydot[1][full.slot[i] + c], ydot[0][compact.slot[i] + c], 0, 0);
     for (size_t c = 1; c <= 2; ++c)
-        assert_close(ydot[1][full.n_y - c], ydot[0][compact.n_y - c], 0, 0);
+        assert_close(ydot[1][fi->n_y - c], ydot[0][ci->n_y - c], 0, 0);
     for (size_t r = 0; r < 4 * compact.roots_per_block; ++r)
         assert_close(g[1][r], g[0][r], 0, 0);
     /* Off the constraint (a Newton iterate), the residual of the velocity row reads v. */
     y[1][stuck + 1] = 0.25;
-    bk_scene_rhs(t, y[1], ydot[1], &full);
+    bk_island_rhs(t, y[1], ydot[1], &islands[1]);
     double yp_stuck_v = 123.0; /* any: an algebraic row has no y' term */
-    double residual = full.differential_id[stuck + 1] * yp_stuck_v - ydot[1][stuck + 1];
+    double residual = fi->differential_id[stuck + 1] * yp_stuck_v - ydot[1][stuck + 1];
     assert_close(residual, 0.25, 0, 0);
     assert_close(ydot[1][stuck], 0.25, 0, 0); /* xi' = v */
+    bk_island_free(&islands[0]);
+    bk_island_free(&islands[1]);
     bk_scene_free(&compact);
     bk_scene_free(&full);
     bk_model_free(m);
 }
 
-/* dv/dt of a slipping block is (applied force - s f_k) / m; energy rates match. */
+/* dv/dt of a slipping block is (applied force - s f_k) / m; the island's energy rates are
+ * its slipping blocks' (the driver's work on a stuck block is counted in closed form by the
+ * run loop). */
 static void test_rhs(void **state)
 {
     (void)state;
@@ -129,15 +148,17 @@ static void test_rhs(void **state)
     s.mode[0] = BK_MODE_SLIP_POS;
     s.v[0] = 3e-3;
     double y[8], ydot[8];
-    bk_scene_restart(&s, 0.5, y);
-    bk_scene_rhs(0.5, y, ydot, &s);
+    bk_island isl = island_of(&s, 0, 0, 2);
+    bk_island_restart(&isl, 0.5, y);
+    bk_island_rhs(0.5, y, ydot, &isl);
     double D = 0.5e-3;
     double applied = 1e4 * (D - 1e-4) + 2e4 * (-2e-4 - 1e-4);
     assert_close(ydot[s.slot[0]], 3e-3, 0, 0);
     assert_close(ydot[s.slot[0] + 1], applied - 0.5 * 9.81, 1e-14, 0);
-    double driver_power = 1e-3 * (1e4 * (D - 1e-4) + 1e4 * (D + 2e-4));
-    assert_close(ydot[s.n_y - 2], driver_power, 1e-14, 0);
-    assert_close(ydot[s.n_y - 1], 0.5 * 9.81 * 3e-3, 1e-14, 0);
+    double driver_power = 1e-3 * (1e4 * (D - 1e-4));
+    assert_close(ydot[isl.n_y - 2], driver_power, 1e-14, 0);
+    assert_close(ydot[isl.n_y - 1], 0.5 * 9.81 * 3e-3, 1e-14, 0);
+    bk_island_free(&isl);
     bk_scene_free(&s);
     bk_model_free(m);
 }
@@ -163,24 +184,26 @@ static void test_roots_clear_of_zero_after_switch(void **state)
         s.from_rest[1] = 1;
         s.v[1] = 0.0;
         double y[16], g[12];
-        bk_scene_restart(&s, t, y);
-        bk_scene_roots(t, y, g, &s);
+        bk_island isl = island_of(&s, 0, 0, 3);
+        bk_island_restart(&isl, t, y);
+        bk_island_roots(t, y, g, &isl);
         double accel = (0.6 - 0.5) * 9.81;               /* (F_s - f_k) / m */
         assert_close(g[R * 1 + BK_ROOT_MAIN], accel, 1e-9, 0); /* stop: s v / (t - t_switch) -> s a */
         /* The minimum root waits for a deceleration: it reads +1 until then. */
         assert_close(g[R * 1 + BK_ROOT_EXTREMUM], 1.0, 0, 0);
         /* A moment later the stop function is s v / dt, still about s a. */
         double ydot[16];
-        bk_scene_rhs(t, y, ydot, &s);
+        bk_island_rhs(t, y, ydot, &isl);
         double y1[16];
-        for (size_t k = 0; k < s.n_y; ++k)
+        for (size_t k = 0; k < isl.n_y; ++k)
             y1[k] = y[k] + 1e-9 * ydot[k];
-        bk_scene_roots(t + 1e-9, y1, g, &s);
+        bk_island_roots(t + 1e-9, y1, g, &isl);
         assert_close(g[R * 1 + BK_ROOT_MAIN], accel, 1e-6, 0);
         /* The stuck neighbours sit well inside their thresholds. */
         assert_true(g[R * 0 + BK_ROOT_MAIN] > 0.1);
         if (R > 2)
             assert_true(g[R * 1 + BK_ROOT_SLACK] > 1e-4);
+        bk_island_free(&isl);
         bk_scene_free(&s);
         bk_model_free(m);
     }
@@ -197,15 +220,17 @@ static void test_minimum_root_arming(void **state)
     s.v[0] = 0.02;
     s.x[0] = 0.0; /* driver at 0: the spring is relaxed, friction decelerates the block */
     double y[8], g[4];
-    bk_scene_restart(&s, 0.0, y);
+    bk_island isl = island_of(&s, 0, 0, 1);
+    bk_island_restart(&isl, 0.0, y);
     assert_int_equal(s.extremum_armed[0], 1); /* decelerating already */
-    bk_scene_roots(0.0, y, g, &s);
+    bk_island_roots(0.0, y, g, &isl);
     assert_close(g[BK_ROOT_EXTREMUM], -0.5 * 9.81, 1e-12, 0);
     s.extremum_armed[0] = 0; /* as after a minimum */
-    bk_scene_roots(0.0, y, g, &s);
+    bk_island_roots(0.0, y, g, &isl);
     assert_close(g[BK_ROOT_EXTREMUM], 1.0, 0, 0);
-    bk_scene_arm(&s, 0.0, y);
+    bk_island_arm(&isl, 0.0, y);
     assert_int_equal(s.extremum_armed[0], 1);
+    bk_island_free(&isl);
     bk_scene_free(&s);
     bk_model_free(m);
 }
@@ -222,11 +247,13 @@ static void test_tension_only_frozen(void **state)
     s.v[0] = 0.05;
     s.x[0] = 1.2e-3; /* ahead of the driver at 1e-3: slack */
     double y[8], ydot[8];
-    bk_scene_restart(&s, 1.0, y);
+    bk_island isl = island_of(&s, 0, 0, 1);
+    bk_island_restart(&isl, 1.0, y);
     assert_int_equal(s.taut[0], 0);
     y[s.slot[0]] = -0.5e-3; /* a trial state behind the driver: still treated as slack */
-    bk_scene_rhs(1.0, y, ydot, &s);
+    bk_island_rhs(1.0, y, ydot, &isl);
     assert_close(ydot[s.slot[0] + 1], -0.5 * 9.81, 1e-14, 0);
+    bk_island_free(&isl);
     bk_scene_free(&s);
     bk_model_free(m);
 }
@@ -243,13 +270,13 @@ static void put_dense(void *matrix, size_t row, size_t col, double value)
 }
 
 /* The whole right-hand side, or the implicit (friction) part of its IMEX split. */
-static void evaluate(bk_scene *s, int implicit_part, double t, const double *y, double *out)
+static void evaluate(bk_island *island, int implicit_part, double t, const double *y, double *out)
 {
     if (implicit_part) {
         double rest[16];
-        assert_int_equal(bk_scene_rhs_split(t, y, rest, out, s), 0);
+        assert_int_equal(bk_island_rhs_split(t, y, rest, out, island), 0);
     } else {
-        assert_int_equal(bk_scene_rhs(t, y, out, s), 0);
+        assert_int_equal(bk_island_rhs(t, y, out, island), 0);
     }
 }
 
@@ -282,15 +309,16 @@ static void check_jacobian(int full_layout, int implicit_part)
         s.mode[i] = modes[i];
     }
     double y[16], t = 0.4;
-    bk_scene_restart(&s, t, y);
-    size_t n = s.n_y;
+    bk_island isl = island_of(&s, 0, 0, 4);
+    bk_island_restart(&isl, t, y);
+    size_t n = isl.n_y;
     dense jac = {n, calloc(n * n, sizeof(double))};
     assert_non_null(jac.a);
     if (implicit_part) {
-        assert_int_equal(bk_scene_jacobian_implicit(t, y, &s, put_dense, &jac), 0);
+        assert_int_equal(bk_island_jacobian_implicit(t, y, &isl, put_dense, &jac), 0);
         double whole[16], f_explicit[16], f_implicit[16];
-        bk_scene_rhs(t, y, whole, &s);
-        bk_scene_rhs_split(t, y, f_explicit, f_implicit, &s);
+        bk_island_rhs(t, y, whole, &isl);
+        bk_island_rhs_split(t, y, f_explicit, f_implicit, &isl);
         for (size_t r = 0; r < n; ++r)
             assert_close(f_explicit[r] + f_implicit[r], whole[r], 1e-15, 1e-300);
         /* Friction only: positions and the energy quadratures are all explicit. */
@@ -300,15 +328,15 @@ static void check_jacobian(int full_layout, int implicit_part)
         assert_true(f_implicit[n - 1] == 0.0 && f_implicit[n - 2] == 0.0);
         assert_true(f_implicit[s.state_slot[1]] != 0.0);
     } else {
-        assert_int_equal(bk_scene_jacobian(t, y, &s, put_dense, &jac), 0);
+        assert_int_equal(bk_island_jacobian(t, y, &isl, put_dense, &jac), 0);
     }
     double up[16], down[16];
     for (size_t c = 0; c < n; ++c) {
         double saved = y[c], h = 1e-7 * fmax(fabs(saved), 1e-6);
         y[c] = saved + h;
-        evaluate(&s, implicit_part, t, y, up);
+        evaluate(&isl, implicit_part, t, y, up);
         y[c] = saved - h;
-        evaluate(&s, implicit_part, t, y, down);
+        evaluate(&isl, implicit_part, t, y, down);
         y[c] = saved;
         for (size_t r = 0; r < n; ++r) {
             double fd = (up[r] - down[r]) / (2 * h);
@@ -318,6 +346,7 @@ static void check_jacobian(int full_layout, int implicit_part)
         }
     }
     free(jac.a);
+    bk_island_free(&isl);
     bk_scene_free(&s);
     bk_model_free(m);
 }
@@ -341,5 +370,5 @@ int main(void)
         cmocka_unit_test(test_tension_only_frozen),
         cmocka_unit_test(test_jacobian),
     };
-    return cmocka_run_group_tests_name("scene", tests, NULL, NULL);
+    return cmocka_run_group_tests_name("island", tests, NULL, NULL);
 }

@@ -1,0 +1,485 @@
+/* An island's compact ODE, or IDA's full-layout DAE (layouts in scene.h): right-hand side,
+ * root functions, Jacobian, and packing between the chain's arrays and the island's vector.
+ * Everything here costs time in proportion to the island, never to the chain: blocks
+ * outside the island are stuck, and only their positions enter (as fixed ends).
+ *
+ * Root functions, per block of the island (all clearly non-zero right after the block
+ * switched, so a just-handled root cannot fire again after a restart):
+ *   stuck:    g = F_s - |F|                    falls through 0 at breakaway
+ *   slipping: g = s v / (t - t_switch)         falls through 0 at the stop; at t_switch it
+ *             (s v when the slip did not        equals its limit s a > 0 instead of 0
+ *              start from rest)
+ *             g = s a                          rises through 0 at a slip-rate minimum, where
+ *                                              a stop hidden inside one step shows as s v < 0
+ *   tension-only spring: g = D - x             the spring's kink (slack/taut) */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene.h"
+
+size_t bk_island_max_y(const bk_scene *scene, size_t len)
+{
+    return len * (2 + scene->max_block_state) + 2;
+}
+
+int bk_island_reserve(bk_island *island, size_t len)
+{
+    if (len <= island->capacity)
+        return 0;
+    size_t max_y = bk_island_max_y(island->scene, len);
+    size_t *active = realloc(island->active, len * sizeof *active);
+    if (!active)
+        return -1;
+    island->active = active;
+    double *mass = realloc(island->active_mass, len * sizeof *mass);
+    if (!mass)
+        return -1;
+    island->active_mass = mass;
+    size_t *stateful = realloc(island->stateful, len * sizeof *stateful);
+    if (!stateful)
+        return -1;
+    island->stateful = stateful;
+    double *id = realloc(island->differential_id, max_y * sizeof *id);
+    if (!id)
+        return -1;
+    island->differential_id = id;
+    int *direction = realloc(island->root_direction,
+                             island->scene->roots_per_block * len * sizeof *direction);
+    if (!direction)
+        return -1;
+    island->root_direction = direction;
+    island->capacity = len;
+    return 0;
+}
+
+void bk_island_free(bk_island *island)
+{
+    free(island->active);
+    free(island->active_mass);
+    free(island->stateful);
+    free(island->differential_id);
+    free(island->root_direction);
+    island->active = island->stateful = NULL;
+    island->active_mass = island->differential_id = NULL;
+    island->root_direction = NULL;
+    island->capacity = 0;
+}
+
+/* Position of block j given the island's vector: blocks integrated by this island from y,
+ * every other block (stuck, so fixed) at x_ref. */
+static inline double position(const bk_island *island, const double *y, long j)
+{
+    if (j < 0)
+        return 0.0; /* a fixed wall */
+    const bk_scene *scene = island->scene;
+    size_t s = scene->slot[j];
+    if (s == BK_NO_SLOT || scene->island_of[j] != island->id)
+        return scene->x_ref[j];
+    return scene->x_ref[j] + y[s];
+}
+
+/* Driver-spring force with the spring's taut/slack state frozen since the restart. */
+static inline double driver_force(const bk_scene *scene, size_t i, double x_i, double driver_pos)
+{
+    if (scene->model->spring == BK_SPRING_TENSION_ONLY && !scene->taut[i])
+        return 0.0;
+    return scene->model->blocks[i].driver_stiffness * (driver_pos - x_i);
+}
+
+static inline double coupling_force(const bk_island *island, const double *y, size_t i, double x_i)
+{
+    const bk_scene *scene = island->scene;
+    double kc = scene->model->coupling_stiffness;
+    if (kc == 0.0)
+        return 0.0;
+    double force = 0.0;
+    if (scene->left[i] != -1)
+        force += kc * (position(island, y, scene->left[i]) - x_i);
+    if (scene->right[i] != -1)
+        force += kc * (position(island, y, scene->right[i]) - x_i);
+    return force;
+}
+
+static inline const double *block_state(const bk_island *island, const double *y, size_t i)
+{
+    const bk_scene *scene = island->scene;
+    const bk_block *b = &scene->model->blocks[i];
+    if (b->law->n_state == 0)
+        return NULL;
+    return y ? &y[scene->state_slot[i]] : &scene->state[b->state_offset];
+}
+
+void bk_island_restart(bk_island *island, double t, double *y)
+{
+    bk_scene *scene = island->scene;
+    const bk_model *model = scene->model;
+    size_t next = 0, R = scene->roots_per_block;
+    size_t max_state = 0;
+    island->n_active = 0;
+    island->n_stateful = 0;
+    island->affine = scene->affine && !scene->full_layout;
+    double driver_pos = bk_driver_position(&model->driver, t);
+    for (size_t k = 0; k < island->len; ++k) {
+        size_t i = bk_island_block(island, k);
+        const bk_block *b = &model->blocks[i];
+        scene->x_ref[i] = scene->x[i];
+        scene->island_of[i] = island->id;
+        int dir = bk_mode_direction((bk_mode)scene->mode[i]);
+        double extension = driver_pos - scene->x[i];
+        /* At the kink itself the spring is taut if the driver is pulling away. */
+        scene->taut[i] = model->spring == BK_SPRING_LINEAR || extension > 0.0 ||
+                         (extension == 0.0 &&
+                          bk_driver_velocity(&model->driver, t) - (dir != 0 ? scene->v[i] : 0.0) > 0.0);
+        if (dir != 0) {
+            scene->slot[i] = next;
+            island->active_mass[island->n_active] = b->mass;
+            island->active[island->n_active++] = i;
+            y[next] = 0.0;
+            y[next + 1] = scene->v[i];
+            island->differential_id[next] = island->differential_id[next + 1] = 1.0;
+            next += 2;
+        } else {
+            scene->v[i] = 0.0;
+            scene->slot[i] = scene->full_layout ? next : BK_NO_SLOT;
+            if (scene->full_layout) {
+                /* Consistent as it stands: v = 0 satisfies the constraint, xi' = v = 0. */
+                y[next] = y[next + 1] = 0.0;
+                island->differential_id[next] = 1.0;
+                island->differential_id[next + 1] = 0.0;
+                next += 2;
+            }
+        }
+        size_t ns = b->law->n_state;
+        if (ns > 0) {
+            /* A block that joins from rest carries the state it aged to. */
+            if (dir == 0)
+                bk_scene_age(scene, i, t);
+            island->stateful[island->n_stateful++] = i;
+            scene->state_slot[i] = next;
+            memcpy(&y[next], &scene->state[b->state_offset], ns * sizeof *y);
+            for (size_t j = 0; j < ns; ++j)
+                island->differential_id[next + j] = 1.0;
+            next += ns;
+            if (ns > max_state)
+                max_state = ns;
+        }
+        island->root_direction[R * k + BK_ROOT_MAIN] = scene->can_stick[i] ? -1 : 0;
+        island->root_direction[R * k + BK_ROOT_EXTREMUM] = dir != 0 && scene->can_stick[i] ? +1 : 0;
+        if (R > 2)
+            island->root_direction[R * k + BK_ROOT_SLACK] = 0;
+    }
+    y[next] = 0.0;     /* driver work on the slipping blocks since t */
+    y[next + 1] = 0.0; /* dissipation since t */
+    island->differential_id[next] = island->differential_id[next + 1] = 1.0;
+    island->n_y = next + 2;
+    island->half_bandwidth = 3 + max_state;
+    island->t_ref = t;
+    for (size_t k = 0; k < island->n_active; ++k) {
+        size_t i = island->active[k];
+        if (scene->from_rest[i] && scene->t_switch[i] == t)
+            scene->extremum_armed[i] = 0;
+    }
+    bk_island_arm(island, t, y);
+}
+
+void bk_island_tolerances(const bk_island *island, double atol_x, double atol_v, double atol_state,
+                          double atol_energy, double *atol)
+{
+    const bk_scene *scene = island->scene;
+    for (size_t k = 0; k < island->len; ++k) {
+        size_t i = bk_island_block(island, k), s = scene->slot[i];
+        if (s == BK_NO_SLOT)
+            continue;
+        atol[s] = atol_x;
+        atol[s + 1] = atol_v;
+    }
+    for (size_t k = 0; k < island->n_stateful; ++k) {
+        size_t i = island->stateful[k];
+        for (size_t j = 0; j < scene->model->blocks[i].law->n_state; ++j)
+            atol[scene->state_slot[i] + j] = atol_state;
+    }
+    atol[island->n_y - 2] = atol_energy;
+    atol[island->n_y - 1] = atol_energy;
+}
+
+void bk_island_unpack(bk_island *island, double t, const double *y, double *work,
+                      double *dissipation)
+{
+    bk_scene *scene = island->scene;
+    const bk_model *model = scene->model;
+    for (size_t k = 0; k < island->len; ++k) {
+        size_t i = bk_island_block(island, k), s = scene->slot[i];
+        if (s == BK_NO_SLOT) {
+            scene->x[i] = scene->x_ref[i];
+            scene->v[i] = 0.0;
+        } else {
+            /* In the full layout a stuck block too reports what the integrator holds. */
+            scene->x[i] = scene->x_ref[i] + y[s];
+            scene->v[i] = y[s + 1];
+            /* A block that cannot stick reports the way it moves (its law is odd in v). */
+            if (!scene->can_stick[i] && scene->v[i] != 0.0)
+                scene->mode[i] = (int8_t)(scene->v[i] > 0.0 ? BK_MODE_SLIP_POS : BK_MODE_SLIP_NEG);
+        }
+    }
+    for (size_t k = 0; k < island->n_stateful; ++k) {
+        size_t i = island->stateful[k];
+        const bk_block *b = &model->blocks[i];
+        memcpy(&scene->state[b->state_offset], &y[scene->state_slot[i]],
+               b->law->n_state * sizeof *y);
+        scene->state_time[i] = t;
+    }
+    if (work)
+        *work = y[island->n_y - 2];
+    if (dissipation)
+        *dissipation = y[island->n_y - 1];
+}
+
+/* The right-hand side, whole (f_implicit NULL) or split: the friction terms (the
+ * velocity rows' -s F / m, the state rates) into f_implicit and the rest into ydot. */
+static void rhs_parts(const bk_island *island, double t, const double *y, double *ydot,
+                      double *f_implicit)
+{
+    const bk_scene *scene = island->scene;
+    const bk_model *model = scene->model;
+    double driver_pos = bk_driver_position(&model->driver, t);
+    double driver_force_sum = 0.0;
+    double dissipation_rate = 0.0;
+    double *state_rates = f_implicit ? f_implicit : ydot;
+    if (f_implicit)
+        memset(f_implicit, 0, island->n_y * sizeof *f_implicit);
+    for (size_t k = 0; k < island->n_active; ++k) {
+        size_t i = island->active[k], s = scene->slot[i];
+        const bk_block *b = &model->blocks[i];
+        double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
+        double dir = (double)scene->mode[i];
+        double spring = driver_force(scene, i, x_i, driver_pos);
+        double applied = spring + coupling_force(island, y, i, x_i);
+        double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
+                                                block_state(island, y, i));
+        ydot[s] = v_i;
+        if (f_implicit) {
+            ydot[s + 1] = applied / b->mass;
+            f_implicit[s + 1] = -dir * friction / b->mass;
+        } else {
+            ydot[s + 1] = (applied - dir * friction) / b->mass;
+        }
+        driver_force_sum += spring;
+        dissipation_rate += dir * friction * v_i;
+    }
+    if (scene->full_layout)
+        for (size_t k = 0; k < island->len; ++k) {
+            size_t i = bk_island_block(island, k);
+            if (bk_scene_stuck(scene, i)) {
+                size_t s = scene->slot[i];
+                ydot[s] = y[s + 1];       /* xi' = v */
+                ydot[s + 1] = -y[s + 1]; /* 0 = -v, algebraic */
+            }
+        }
+    for (size_t k = 0; k < island->n_stateful; ++k) {
+        size_t i = island->stateful[k];
+        const bk_block *b = &model->blocks[i];
+        /* A stuck block's state ages at rest.  In the full layout its v is 0 by the
+         * constraint anyway, and |v| has no derivative there for the Jacobian. */
+        double speed = bk_scene_stuck(scene, i) ? 0.0 : fabs(y[scene->slot[i] + 1]);
+        b->law->state_rate(b->friction_params, speed, &y[scene->state_slot[i]],
+                           &state_rates[scene->state_slot[i]]);
+        if (f_implicit)
+            for (size_t j = 0; j < b->law->n_state; ++j)
+                ydot[scene->state_slot[i] + j] = 0.0;
+    }
+    ydot[island->n_y - 2] = bk_driver_velocity(&model->driver, t) * driver_force_sum;
+    ydot[island->n_y - 1] = dissipation_rate;
+}
+
+int bk_island_rhs(double t, const double *y, double *ydot, void *user)
+{
+    rhs_parts(user, t, y, ydot, NULL);
+    return 0;
+}
+
+int bk_island_rhs_split(double t, const double *y, double *f_explicit, double *f_implicit, void *user)
+{
+    rhs_parts(user, t, y, f_explicit, f_implicit);
+    return 0;
+}
+
+/* d(sliding force)/d(slip rate) and d/d(state) of block i (N s/m, N per state unit). */
+static void friction_derivatives(const bk_scene *scene, size_t i, double slip_rate, const double *state,
+                                 double *d_rate, double *d_state)
+{
+    const bk_block *b = &scene->model->blocks[i];
+    const bk_friction_law *law = b->law;
+    double h = 1e-6 * fmax(fabs(slip_rate), 1e-9);
+    *d_rate = (law->sliding_force(b->friction_params, scene->normal[i], slip_rate + h, state) -
+               law->sliding_force(b->friction_params, scene->normal[i], slip_rate - h, state)) /
+              (2.0 * h);
+    if (law->n_state == 0) {
+        *d_state = 0.0;
+        return;
+    }
+    double shifted[BK_FRICTION_MAX_STATE];
+    double hs = 1e-6 * fmax(fabs(state[0]), 1e-12);
+    shifted[0] = state[0] + hs;
+    double up = law->sliding_force(b->friction_params, scene->normal[i], slip_rate, shifted);
+    shifted[0] = state[0] - hs;
+    double down = law->sliding_force(b->friction_params, scene->normal[i], slip_rate, shifted);
+    *d_state = (up - down) / (2.0 * hs);
+}
+
+/* The Jacobian of the whole right-hand side, or (friction_only) of its friction part. */
+static void jacobian_parts(const bk_island *island, double t, const double *y, int friction_only,
+                           void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
+{
+    const bk_scene *scene = island->scene;
+    const bk_model *model = scene->model;
+    double kc = model->coupling_stiffness;
+    double speed = bk_driver_velocity(&model->driver, t);
+    size_t work_row = island->n_y - 2, dissipation_row = island->n_y - 1;
+    for (size_t k = 0; k < island->n_active; ++k) {
+        size_t i = island->active[k], s = scene->slot[i];
+        const bk_block *b = &model->blocks[i];
+        double dir = (double)scene->mode[i], v_i = y[s + 1], m = b->mass;
+        double spring = model->spring == BK_SPRING_TENSION_ONLY && !scene->taut[i] ? 0.0 : b->driver_stiffness;
+        if (!friction_only) {
+            put(matrix, s, s + 1, 1.0); /* xi' = v */
+            /* Springs: the block's own stiffness, and its partners integrated here. */
+            put(matrix, s + 1, s, -(spring + kc * bk_model_coupling_count(model, i)) / m);
+            const long partners[2] = {scene->left[i], scene->right[i]};
+            for (size_t p = 0; p < 2 && kc > 0.0; ++p)
+                if (partners[p] >= 0 && scene->slot[partners[p]] != BK_NO_SLOT &&
+                    scene->island_of[partners[p]] == island->id)
+                    put(matrix, s + 1, scene->slot[partners[p]], kc / m);
+        }
+        /* Friction: -dir F(dir v, state) / m. */
+        const double *state = block_state(island, y, i);
+        double d_rate, d_state;
+        friction_derivatives(scene, i, dir * v_i, state, &d_rate, &d_state);
+        put(matrix, s + 1, s + 1, -d_rate / m);
+        if (state)
+            put(matrix, s + 1, scene->state_slot[i], -dir * d_state / m);
+        if (friction_only)
+            continue;
+        /* Energy rates: driver power V k (D - x), friction power dir F v. */
+        double force = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i, state);
+        put(matrix, work_row, s, -speed * spring);
+        put(matrix, dissipation_row, s + 1, dir * force + v_i * d_rate);
+        if (state)
+            put(matrix, dissipation_row, scene->state_slot[i], dir * v_i * d_state);
+    }
+    if (scene->full_layout && !friction_only)
+        for (size_t k = 0; k < island->len; ++k) {
+            size_t i = bk_island_block(island, k);
+            if (bk_scene_stuck(scene, i)) {
+                size_t s = scene->slot[i];
+                put(matrix, s, s + 1, 1.0);
+                put(matrix, s + 1, s + 1, -1.0);
+            }
+        }
+    /* State equations: d(rate)/d(state) and, while slipping, d(rate)/dv. */
+    for (size_t k = 0; k < island->n_stateful; ++k) {
+        size_t i = island->stateful[k], q = scene->state_slot[i], s = scene->slot[i];
+        const bk_block *b = &model->blocks[i];
+        int slipping = !bk_scene_stuck(scene, i);
+        double v_i = slipping ? y[s + 1] : 0.0, spd = fabs(v_i);
+        double st[BK_FRICTION_MAX_STATE], up[BK_FRICTION_MAX_STATE], down[BK_FRICTION_MAX_STATE];
+        double hs = 1e-6 * fmax(fabs(y[q]), 1e-12);
+        st[0] = y[q] + hs;
+        b->law->state_rate(b->friction_params, spd, st, up);
+        st[0] = y[q] - hs;
+        b->law->state_rate(b->friction_params, spd, st, down);
+        put(matrix, q, q, (up[0] - down[0]) / (2.0 * hs));
+        if (slipping) {
+            double hv = 1e-6 * fmax(spd, 1e-9);
+            b->law->state_rate(b->friction_params, spd + hv, &y[q], up);
+            b->law->state_rate(b->friction_params, fmax(spd - hv, 0.0), &y[q], down);
+            double d_speed = (up[0] - down[0]) / (spd + hv - fmax(spd - hv, 0.0));
+            put(matrix, q, s + 1, v_i >= 0.0 ? d_speed : -d_speed);
+        }
+    }
+}
+
+int bk_island_jacobian(double t, const double *y, void *user,
+                       void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
+{
+    jacobian_parts(user, t, y, 0, put, matrix);
+    return 0;
+}
+
+int bk_island_jacobian_implicit(double t, const double *y, void *user,
+                                void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
+{
+    jacobian_parts(user, t, y, 1, put, matrix);
+    return 0;
+}
+
+int bk_island_roots(double t, const double *y, double *g, void *user)
+{
+    const bk_island *island = user;
+    const bk_scene *scene = island->scene;
+    const bk_model *model = scene->model;
+    size_t R = scene->roots_per_block;
+    double driver_pos = bk_driver_position(&model->driver, t);
+    for (size_t k = 0; k < island->len; ++k) {
+        size_t i = bk_island_block(island, k);
+        const bk_block *b = &model->blocks[i];
+        double *gi = &g[R * k];
+        double x_i = position(island, y, (long)i);
+        double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i);
+        const double *state = block_state(island, y, i);
+        size_t s = scene->slot[i];
+        if (!scene->can_stick[i]) {
+            gi[BK_ROOT_MAIN] = 1.0; /* smooth through v = 0: nothing to locate */
+            gi[BK_ROOT_EXTREMUM] = 1.0;
+        } else if (bk_scene_stuck(scene, i)) {
+            gi[BK_ROOT_MAIN] = b->law->static_threshold(b->friction_params, scene->normal[i], state) -
+                               fabs(applied);
+            gi[BK_ROOT_EXTREMUM] = 1.0;
+        } else {
+            double dir = (double)scene->mode[i];
+            double v_i = y[s + 1];
+            double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i, state);
+            double slip_accel = dir * (applied - dir * friction) / b->mass;
+            double since = t - scene->t_switch[i];
+            if (!scene->from_rest[i])
+                gi[BK_ROOT_MAIN] = dir * v_i;
+            else
+                gi[BK_ROOT_MAIN] = since > 0.0 ? dir * v_i / since : slip_accel;
+            gi[BK_ROOT_EXTREMUM] = scene->detect_extrema && scene->extremum_armed[i] ? slip_accel : 1.0;
+        }
+        if (R > 2)
+            gi[BK_ROOT_SLACK] = driver_pos - x_i;
+    }
+    return 0;
+}
+
+double bk_island_slip_acceleration(const bk_island *island, size_t i, double t, const double *y)
+{
+    const bk_scene *scene = island->scene;
+    const bk_block *b = &scene->model->blocks[i];
+    size_t s = scene->slot[i];
+    double driver_pos = bk_driver_position(&scene->model->driver, t);
+    double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
+    double dir = (double)scene->mode[i];
+    double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i);
+    double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
+                                            block_state(island, y, i));
+    return dir * (applied - dir * friction) / b->mass;
+}
+
+void bk_island_arm(bk_island *island, double t, const double *y)
+{
+    bk_scene *scene = island->scene;
+    for (size_t k = 0; k < island->n_active; ++k) {
+        size_t i = island->active[k];
+        if (scene->extremum_armed[i] || !scene->can_stick[i])
+            continue;
+        const bk_block *b = &scene->model->blocks[i];
+        double threshold = b->law->static_threshold(b->friction_params, scene->normal[i],
+                                                    block_state(island, y, i));
+        /* Clearly negative: well beyond the rounding of (force - friction) / m. */
+        if (bk_island_slip_acceleration(island, i, t, y) < -1e-9 * threshold / b->mass)
+            scene->extremum_armed[i] = 1;
+    }
+}

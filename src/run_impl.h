@@ -1,0 +1,159 @@
+/* Internal: the run loop's state, shared by run.c (set-up and the scheduler), run_islands.c
+ * (the partition into islands and quiet blocks, island steps and events) and run_output.c
+ * (rows, transitions, energies, checkpoints). */
+#ifndef BKSIM_RUN_IMPL_H
+#define BKSIM_RUN_IMPL_H
+
+#include <stddef.h>
+
+#include "bksim/checkpoint.h"
+#include "bksim/run.h"
+#include "bksim/solver.h"
+#include "heap.h"
+#include "scene.h"
+
+/* An island with its own integrator (scene.h says what an island is). */
+typedef struct run_island {
+    bk_island island;        /* layout and ODE; the problem's user data */
+    bk_ode_problem problem;
+    void *solver;            /* an instance of the back-end, from the pool */
+    double *y, *y_probe, *atol;
+    int *found;              /* root_info of the pending event */
+    size_t capacity_y, capacity_roots;
+    int live;
+    int stepped;             /* stepped since its (re)start: else y holds the state at t_reached */
+    double t_reached;        /* s, where the integrator is */
+    /* The event the last step found, handled when its time comes. */
+    int pending;
+    int from_root;           /* a root fired (else a stop was missed at a step end) */
+    double t_event;          /* s; a hidden stop rewinds it before the root */
+    size_t hidden_block;     /* the block whose hidden stop it is, or SIZE_MAX */
+} run_island;
+
+typedef struct run_ctx {
+    const bk_config *config;
+    const bk_model *model;
+    const bk_sink *sink;
+    bk_error *err;
+    bk_run_stats *stats;
+    bk_progress_fn progress;
+    void *progress_user;
+
+    bk_scene scene;
+    const bk_solver_backend *backend;
+    bk_solver_options options; /* with auto values resolved */
+    double atol_x, atol_v, atol_state, atol_energy;
+
+    /* Islands, by id; ids of dissolved islands are reused. */
+    run_island **islands;
+    size_t islands_capacity, islands_used;
+    size_t *free_ids;
+    size_t n_free;
+    size_t live_islands;
+    bk_heap island_queue;    /* live islands by their pending event's time, else t_reached */
+    /* Back-end instances: every one ever made (for the counters), the idle ones reused. */
+    void **solvers;
+    size_t n_solvers, solvers_capacity;
+    void **idle;
+    size_t n_idle;
+    /* Quiet stuck blocks by failure time (closed form, no integrator). */
+    bk_heap quiet;
+    size_t *batch;           /* blocks failing at one instant, scratch */
+
+    /* Energy bookkeeping: what finished, and each stuck block's driver-spring energy when its
+     * stuck interval began (the driver's work on a stuck block is that spring's gain). */
+    double work_closed, dissipation_closed; /* J */
+    double *spring_energy_ref;             /* J, per block */
+    double work, dissipation;              /* J, totals at the last unpack_all */
+
+    /* Transitions of the current instant, flushed in block order when it ends. */
+    bk_transition *instant;
+    size_t n_instant, instant_capacity;
+    double t_instant;
+    /* An event row owed for the instant at t_row_due (NAN: none). */
+    double t_row_due;
+
+    /* Row buffers. */
+    double *friction, *cof, *state_out;
+
+    /* Output schedule. */
+    double t_end;
+    double interval;
+    long next_sample;     /* index k of the next sample time k * interval; -1 when done */
+    double t_last_row;
+    long steps_since_row; /* integrator steps since the last row or transition */
+    int event_rows;
+
+    /* Chattering guard. */
+    double instant_window;
+    double *last_transition;
+    long *instant_count;
+
+    double elastic0, kinetic0;
+    double wall_start;    /* s, monotonic clock at the start */
+    double cpu0;          /* clock() at the start */
+
+    /* Checkpoints: forced restarts at multiples of the interval. */
+    double checkpoint_interval;
+    long next_checkpoint; /* index k of the next checkpoint time k * interval */
+    bk_run_stats base;    /* counters of the run this one resumed, if any */
+} run_ctx;
+
+/* ---- run.c ---- */
+double bk_run_wall_seconds(void);
+/* The wall-clock limit and a stop request, checked at every step and row. */
+int bk_run_report_progress(run_ctx *ctx, double t);
+/* Next checkpoint time (+inf without checkpoints); always < t_end or +inf. */
+double bk_run_checkpoint_time(const run_ctx *ctx);
+/* Where every island's integrator stops: the next checkpoint or t_end. */
+double bk_run_stop_time(const run_ctx *ctx);
+
+/* ---- run_islands.c ---- */
+int bk_run_islands_init(run_ctx *ctx);
+void bk_run_islands_free(run_ctx *ctx);
+/* Dissolve every island and rebuild the whole partition at t (the chain's arrays hold the
+ * state there): at the start, at checkpoints and on resuming. */
+int bk_run_partition_all(run_ctx *ctx, double t);
+/* One step of island id; records the event it finds (pending). */
+int bk_run_island_step(run_ctx *ctx, size_t id);
+/* Apply the machine to block i at t (the chain's arrays unpacked there): the transition and
+ * the energy books.  Returns 1 when its mode changed, 0 when not, < 0 on failure. */
+int bk_run_apply_event(run_ctx *ctx, double t, size_t i, bk_mode_event event);
+/* Handle the pending event of island id at its t_event. */
+int bk_run_island_event(run_ctx *ctx, size_t id);
+/* Every quiet block failing at t (to rounding) breaks away. */
+int bk_run_quiet_failures(run_ctx *ctx, double t);
+/* Fill the chain's arrays with every island's state at t (interpolated, or the island's
+ * own vector where it stands at t), and ctx->work and ctx->dissipation with the totals. */
+int bk_run_unpack_all(run_ctx *ctx, double t);
+/* Counters of every back-end instance so far. */
+void bk_run_solver_counters(const run_ctx *ctx, bk_solver_counters *total);
+
+/* ---- run_output.c ---- */
+/* A row from the chain's arrays at t (bk_run_unpack_all first). */
+int bk_run_emit_row(run_ctx *ctx, double t, int is_event);
+/* A mode change of block i at t with the applied force then: chattering guard, statistics,
+ * and the transition, buffered until its instant ends. */
+int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_mode to,
+                             double applied_force);
+/* Send the buffered transitions of the instant, in block order. */
+int bk_run_flush_instant(run_ctx *ctx);
+/* Block i changes between stuck and slipping at t (the chain's arrays unpacked): the
+ * driver's work on it while it was stuck is closed, or its stuck interval opens. */
+void bk_run_leave_stuck(run_ctx *ctx, size_t i, double t);
+void bk_run_enter_stuck(run_ctx *ctx, size_t i, double t);
+/* Driver work and dissipation at t from the closed totals, the islands' increments and the
+ * stuck blocks' springs (J); the islands' increments are given. */
+void bk_run_energy_totals(run_ctx *ctx, double t, double island_work, double island_dissipation);
+/* Statistics so far, the resumed run's included. */
+void bk_run_collect_stats(const run_ctx *ctx, bk_run_stats *stats, double cpu0);
+/* The state at a checkpoint time t (islands stopped there): recorded, then every island
+ * restarted, as a resumed run will. */
+int bk_run_checkpoint(run_ctx *ctx, double t);
+/* The state of a checkpoint, back into the chain. */
+int bk_run_resume(run_ctx *ctx, const bk_checkpoint *cp);
+/* Close every stuck interval's books at t: the closed totals take everything so far and the
+ * stuck blocks' references restart at t (a checkpoint, or a resumed run's start). */
+void bk_run_rebase_energy(run_ctx *ctx, double t);
+
+#endif

@@ -1,0 +1,821 @@
+/* The chain's partition into islands and quiet blocks (scene.h), and what happens to them:
+ * an island steps with its own integrator and finds its next event; at an event only that
+ * island (and a neighbour it may merge with) is rebuilt; a quiet block breaks away at a time
+ * known in closed form, kept in a priority queue.  Nothing here loops over the chain except
+ * bk_run_partition_all (start, checkpoints) and bk_run_unpack_all (output rows).
+ *
+ * Why the partition is safe: a quiet block's neighbours are stuck, so its applied force is
+ * affine in the driver's position until one of them moves, which only happens through an
+ * event that rebuilds the partition around it (and recomputes its failure time).  An island
+ * depends on blocks outside it only through stuck ends, so islands integrated to different
+ * times never see each other: the scheduler (run.c) always handles the earliest pending
+ * event first, and every island's last step then contains that time, so its state there is
+ * at hand (dense output) when a merge needs it. */
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_roots.h>
+
+#include "run_impl.h"
+
+/* Quiet blocks whose failure times agree to this many ulps fail at one instant (a uniform
+ * chain's blocks all do). */
+#define SIMULTANEOUS_EPS (8.0 * DBL_EPSILON)
+/* Samples of a stateful block's threshold margin per doubling of the look-ahead. */
+#define AGING_SCAN_START (1.0 / 64.0)
+
+/* ---------------------------------------------------------------- bookkeeping --- */
+
+int bk_run_islands_init(run_ctx *ctx)
+{
+    size_t n = ctx->scene.n;
+    if (bk_heap_init(&ctx->quiet, n) != 0 || bk_heap_init(&ctx->island_queue, 16) != 0)
+        return -1;
+    ctx->batch = malloc(n * sizeof *ctx->batch);
+    return ctx->batch ? 0 : -1;
+}
+
+void bk_run_islands_free(run_ctx *ctx)
+{
+    for (size_t id = 0; id < ctx->islands_used; ++id) {
+        run_island *isl = ctx->islands[id];
+        bk_island_free(&isl->island);
+        free(isl->y);
+        free(isl->y_probe);
+        free(isl->atol);
+        free(isl->found);
+        free(isl);
+    }
+    for (size_t k = 0; k < ctx->n_solvers; ++k)
+        ctx->backend->destroy(ctx->solvers[k]);
+    free(ctx->solvers);
+    free(ctx->idle);
+    free(ctx->islands);
+    free(ctx->free_ids);
+    free(ctx->batch);
+    bk_heap_free(&ctx->quiet);
+    bk_heap_free(&ctx->island_queue);
+}
+
+void bk_run_solver_counters(const run_ctx *ctx, bk_solver_counters *total)
+{
+    memset(total, 0, sizeof *total);
+    for (size_t k = 0; k < ctx->n_solvers; ++k) {
+        bk_solver_counters c;
+        ctx->backend->counters(ctx->solvers[k], &c);
+        total->steps += c.steps;
+        total->rhs_evals += c.rhs_evals;
+        total->root_evals += c.root_evals;
+        total->err_test_fails += c.err_test_fails;
+        total->nonlin_iters += c.nonlin_iters;
+    }
+}
+
+static double island_key(const run_island *isl)
+{
+    return isl->pending ? isl->t_event : isl->t_reached;
+}
+
+/* A back-end instance: an idle one, else a new one (kept for its counters). */
+static int take_solver(run_ctx *ctx, void **solver)
+{
+    if (ctx->n_idle > 0) {
+        *solver = ctx->idle[--ctx->n_idle];
+        return BK_OK;
+    }
+    if (ctx->n_solvers == ctx->solvers_capacity) {
+        size_t cap = ctx->solvers_capacity ? 2 * ctx->solvers_capacity : 8;
+        void **all = realloc(ctx->solvers, cap * sizeof *all);
+        if (!all)
+            return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for solver instances");
+        ctx->solvers = all;
+        void **idle = realloc(ctx->idle, cap * sizeof *idle);
+        if (!idle)
+            return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for solver instances");
+        ctx->idle = idle;
+        ctx->solvers_capacity = cap;
+    }
+    int rc = ctx->backend->create(solver, &ctx->options, ctx->err);
+    if (rc != BK_OK)
+        return rc;
+    ctx->solvers[ctx->n_solvers++] = *solver;
+    return BK_OK;
+}
+
+/* A free island id with its arrays (kept from an earlier island when there is one). */
+static int new_island(run_ctx *ctx, size_t *id)
+{
+    if (ctx->n_free > 0) {
+        *id = ctx->free_ids[--ctx->n_free];
+    } else {
+        if (ctx->islands_used == ctx->islands_capacity) {
+            size_t cap = ctx->islands_capacity ? 2 * ctx->islands_capacity : 16;
+            run_island **grown = realloc(ctx->islands, cap * sizeof *grown);
+            if (!grown)
+                return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for islands");
+            ctx->islands = grown;
+            size_t *ids = realloc(ctx->free_ids, cap * sizeof *ids);
+            if (!ids || bk_heap_reserve(&ctx->island_queue, cap) != 0)
+                return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for islands");
+            ctx->free_ids = ids;
+            ctx->islands_capacity = cap;
+        }
+        /* Each island on its own: back-ends keep a pointer to it (the problem's user). */
+        run_island *isl = calloc(1, sizeof *isl);
+        if (!isl)
+            return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for islands");
+        *id = ctx->islands_used++;
+        ctx->islands[*id] = isl;
+        isl->island.scene = &ctx->scene;
+        isl->island.id = *id;
+    }
+    run_island *isl = ctx->islands[*id];
+    int rc = take_solver(ctx, &isl->solver);
+    if (rc != BK_OK) {
+        ctx->free_ids[ctx->n_free++] = *id;
+        return rc;
+    }
+    isl->live = 1;
+    ctx->live_islands++;
+    return BK_OK;
+}
+
+static void release_island(run_ctx *ctx, size_t id)
+{
+    run_island *isl = ctx->islands[id];
+    bk_heap_remove(&ctx->island_queue, id);
+    ctx->idle[ctx->n_idle++] = isl->solver;
+    isl->solver = NULL;
+    isl->live = 0;
+    isl->pending = 0;
+    ctx->live_islands--;
+    ctx->free_ids[ctx->n_free++] = id;
+}
+
+static int reserve_vectors(run_ctx *ctx, run_island *isl, size_t len)
+{
+    size_t n_y = bk_island_max_y(&ctx->scene, len);
+    size_t n_roots = ctx->scene.roots_per_block * len;
+    if (bk_island_reserve(&isl->island, len) != 0)
+        return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for an island of %zu blocks", len);
+    if (n_y > isl->capacity_y) {
+        double *y = realloc(isl->y, n_y * sizeof *y);
+        double *probe = y ? realloc(isl->y_probe, n_y * sizeof *probe) : NULL;
+        double *atol = probe ? realloc(isl->atol, n_y * sizeof *atol) : NULL;
+        if (y)
+            isl->y = y;
+        if (probe)
+            isl->y_probe = probe;
+        if (!atol)
+            return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for an island of %zu blocks", len);
+        isl->atol = atol;
+        isl->capacity_y = n_y;
+    }
+    if (n_roots > isl->capacity_roots) {
+        int *found = realloc(isl->found, n_roots * sizeof *found);
+        if (!found)
+            return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for an island of %zu blocks", len);
+        isl->found = found;
+        isl->capacity_roots = n_roots;
+    }
+    return BK_OK;
+}
+
+/* (Re)start island id at t on its blocks' current state. */
+static int start_island(run_ctx *ctx, size_t id, double t)
+{
+    run_island *isl = ctx->islands[id];
+    bk_island *island = &isl->island;
+    int rc = reserve_vectors(ctx, isl, island->len);
+    if (rc != BK_OK)
+        return rc;
+    for (size_t k = 0; k < island->len; ++k)
+        bk_heap_remove(&ctx->quiet, bk_island_block(island, k));
+    bk_island_restart(island, t, isl->y);
+    bk_island_tolerances(island, ctx->atol_x, ctx->atol_v, ctx->atol_state, ctx->atol_energy, isl->atol);
+    isl->problem = (bk_ode_problem){
+        .user = island,
+        .rhs = bk_island_rhs,
+        .jacobian = bk_island_jacobian,
+        .rhs_split = bk_island_rhs_split,
+        .jacobian_implicit = bk_island_jacobian_implicit,
+        .roots = bk_island_roots,
+        .n_roots = bk_island_n_roots(island),
+        .root_direction = island->root_direction,
+        .half_bandwidth = island->half_bandwidth,
+        /* Pairs lead the layout only when no friction state is interleaved; the full
+         * layout's stuck pairs are no oscillators, so it declares no structure. */
+        .n_pairs = ctx->model->n_friction_state == 0 && !ctx->scene.full_layout ? island->n_active : 0,
+        .pair_mass = island->active_mass,
+        .affine = island->affine,
+        .differential_id = ctx->scene.full_layout ? island->differential_id : NULL,
+    };
+    rc = ctx->backend->start(isl->solver, &isl->problem, t, isl->y, isl->atol, island->n_y,
+                             bk_run_stop_time(ctx), ctx->err);
+    if (rc != BK_OK)
+        return rc;
+    ctx->stats->integrator_starts++;
+    isl->stepped = 0;
+    isl->pending = 0;
+    isl->t_reached = t;
+    bk_heap_set(&ctx->island_queue, id, t);
+    return BK_OK;
+}
+
+/* The island's state at t into the chain's arrays: its own vector where it stands at t,
+ * else dense output (t lies in its last step: see the scheduler in run.c). */
+static int unpack_island(run_ctx *ctx, run_island *isl, double t, double *work, double *dissipation)
+{
+    const double *y = isl->y;
+    if (t != isl->t_reached) {
+        int rc = ctx->backend->interpolate(isl->solver, t, isl->y_probe, ctx->err);
+        if (rc != BK_OK)
+            return rc;
+        y = isl->y_probe;
+    }
+    bk_island_unpack(&isl->island, t, y, work, dissipation);
+    return BK_OK;
+}
+
+int bk_run_unpack_all(run_ctx *ctx, double t)
+{
+    double work = 0.0, dissipation = 0.0;
+    for (size_t id = 0; id < ctx->islands_used; ++id) {
+        run_island *isl = ctx->islands[id];
+        if (!isl->live)
+            continue;
+        double w, d;
+        int rc = unpack_island(ctx, isl, t, &w, &d);
+        if (rc != BK_OK)
+            return rc;
+        work += w;
+        dissipation += d;
+    }
+    bk_run_energy_totals(ctx, t, work, dissipation);
+    return BK_OK;
+}
+
+/* ------------------------------------------------------- quiet blocks' failures --- */
+
+/* The force on quiet block i at driver position D (its neighbours stuck, so fixed). */
+static double quiet_force(const run_ctx *ctx, size_t i, double driver_pos)
+{
+    return bk_model_applied_force(ctx->model, i, ctx->scene.x, driver_pos);
+}
+
+/* Time block i breaks away with a constant threshold, from the applied force's affine
+ * dependence on the driver position; +inf if never. */
+static double coulomb_failure(const run_ctx *ctx, size_t i, double t, double threshold)
+{
+    const bk_model *model = ctx->model;
+    const bk_scene *scene = &ctx->scene;
+    double k = model->blocks[i].driver_stiffness;
+    double velocity = bk_driver_velocity(&model->driver, t);
+    if (k == 0.0 || velocity == 0.0)
+        return INFINITY;
+    double coupling = bk_model_coupling_force(model, i, scene->x);
+    /* The driver spring force rises with D when the driver advances, falls when it retreats;
+     * a tension-only spring can only pull, so a retreating driver never breaks it away
+     * unless the coupling alone does. */
+    double target_force = velocity > 0.0 ? threshold - coupling : -threshold - coupling;
+    if (velocity < 0.0 && model->spring == BK_SPRING_TENSION_ONLY && target_force < 0.0)
+        return INFINITY;
+    double target_position = scene->x[i] + target_force / k;
+    double here = bk_driver_position(&model->driver, t);
+    if ((target_position - here) * velocity <= 0.0)
+        return t;
+    return bk_driver_time_at(&model->driver, t, target_position);
+}
+
+typedef struct aging_margin {
+    const run_ctx *ctx;
+    size_t block;
+} aging_margin;
+
+/* Threshold minus |applied force| of a resting block at time t. */
+static double margin_at(double t, void *user)
+{
+    const aging_margin *m = user;
+    const run_ctx *ctx = m->ctx;
+    const bk_block *b = &ctx->model->blocks[m->block];
+    double state[BK_FRICTION_MAX_STATE];
+    bk_scene_state_at_rest(&ctx->scene, m->block, t, state);
+    double threshold = b->law->static_threshold(b->friction_params, ctx->scene.normal[m->block], state);
+    return threshold - fabs(quiet_force(ctx, m->block, bk_driver_position(&ctx->model->driver, t)));
+}
+
+/* The failure time of a resting block whose threshold ages (state at rest): the first zero
+ * of the margin after t.  The margin is sampled at look-aheads doubling from a fraction of
+ * the time the driver needs to load the spring by the threshold, then the crossing is
+ * located by Brent.  Aging laws strengthen the contact concavely in time while the driver
+ * loads it linearly, so the margin has one falling zero and sampling cannot step over it. */
+static double aging_failure(const run_ctx *ctx, size_t i, double t)
+{
+    aging_margin m = {ctx, i};
+    double g0 = margin_at(t, &m);
+    if (!(g0 > 0.0))
+        return t;
+    const bk_block *b = &ctx->model->blocks[i];
+    double speed = fabs(bk_driver_velocity(&ctx->model->driver, t));
+    if (b->driver_stiffness == 0.0 || speed == 0.0)
+        return INFINITY;
+    double span = g0 / (b->driver_stiffness * speed);
+    double lo = t, hi = t, horizon = ctx->t_end;
+    for (double ahead = AGING_SCAN_START * span;; ahead *= 2.0) {
+        lo = hi;
+        hi = t + ahead;
+        if (hi > horizon)
+            hi = horizon;
+        if (margin_at(hi, &m) <= 0.0)
+            break;
+        if (hi >= horizon)
+            return INFINITY;
+    }
+    gsl_function fn = {margin_at, &m};
+    gsl_root_fsolver *solver = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
+    if (!solver)
+        return lo;
+    if (gsl_root_fsolver_set(solver, &fn, lo, hi) != GSL_SUCCESS) {
+        gsl_root_fsolver_free(solver);
+        return hi;
+    }
+    for (int iter = 0; iter < 200; ++iter) {
+        if (gsl_root_fsolver_iterate(solver) != GSL_SUCCESS)
+            break;
+        double a = gsl_root_fsolver_x_lower(solver), c = gsl_root_fsolver_x_upper(solver);
+        if (gsl_root_test_interval(a, c, 0.0, 4.0 * DBL_EPSILON) == GSL_SUCCESS)
+            break;
+    }
+    /* The upper end is past the zero, as at a root an integrator reports. */
+    double failure = gsl_root_fsolver_x_upper(solver);
+    gsl_root_fsolver_free(solver);
+    return failure;
+}
+
+static double failure_time(const run_ctx *ctx, size_t i, double t)
+{
+    if (ctx->model->blocks[i].law->n_state == 0)
+        return coulomb_failure(ctx, i, t, bk_scene_static_threshold(&ctx->scene, i));
+    return aging_failure(ctx, i, t);
+}
+
+/* Block i (stuck, next to no slipping block) leaves the integrators at t. */
+static void make_quiet(run_ctx *ctx, size_t i, double t)
+{
+    bk_scene *scene = &ctx->scene;
+    scene->island_of[i] = BK_NO_ISLAND;
+    scene->slot[i] = BK_NO_SLOT;
+    scene->x_ref[i] = scene->x[i];
+    scene->v[i] = 0.0;
+    bk_heap_set(&ctx->quiet, i, failure_time(ctx, i, t));
+}
+
+/* --------------------------------------------------------------- the partition --- */
+
+static size_t wrap(const run_ctx *ctx, long j)
+{
+    long n = (long)ctx->scene.n;
+    long i = j % n;
+    return (size_t)(i < 0 ? i + n : i);
+}
+
+static int periodic(const run_ctx *ctx)
+{
+    return ctx->model->boundary == BK_BOUNDARY_PERIODIC;
+}
+
+/* Dissolve island id at t: its state into the chain (unless already there) and its energy
+ * increments into the closed totals. */
+static int dissolve(run_ctx *ctx, size_t id, double t, int taken)
+{
+    run_island *isl = ctx->islands[id];
+    if (!taken) {
+        double work, dissipation;
+        int rc = unpack_island(ctx, isl, t, &work, &dissipation);
+        if (rc != BK_OK)
+            return rc;
+        ctx->work_closed += work;
+        ctx->dissipation_closed += dissipation;
+    }
+    bk_scene *scene = &ctx->scene;
+    for (size_t k = 0; k < isl->island.len; ++k) {
+        size_t i = bk_island_block(&isl->island, k);
+        scene->island_of[i] = BK_NO_ISLAND;
+        scene->slot[i] = BK_NO_SLOT;
+    }
+    release_island(ctx, id);
+    return BK_OK;
+}
+
+/* A new island over chain positions [lo, hi] (unwrapped), started at t. */
+static int found_island(run_ctx *ctx, long lo, long hi, double t)
+{
+    size_t id = BK_NO_ISLAND;
+    int rc = new_island(ctx, &id);
+    if (rc != BK_OK)
+        return rc;
+    bk_island *island = &ctx->islands[id]->island;
+    island->start = wrap(ctx, lo);
+    island->len = (size_t)(hi - lo + 1);
+    return start_island(ctx, id, t);
+}
+
+/* Rebuild islands and quiet blocks over chain positions [lo, hi] (unwrapped; every block
+ * there belongs to no island, and the blocks at both ends are stuck unless they are chain
+ * ends), or over the whole ring.  Slipping runs that one stuck block separates form one
+ * island with the stuck blocks around them. */
+static int rebuild(run_ctx *ctx, long lo, long hi, int whole_ring, double t)
+{
+    const bk_scene *scene = &ctx->scene;
+    long n = (long)scene->n;
+    if (whole_ring) {
+        /* Start the scan where two stuck blocks meet: no island crosses there.  Without such
+         * a place every stuck block sits between slipping ones: one island, the ring. */
+        long cut = -1;
+        for (long j = 0; j < n && cut < 0; ++j)
+            if (bk_scene_stuck(scene, wrap(ctx, j)) && bk_scene_stuck(scene, wrap(ctx, j - 1)))
+                cut = j;
+        if (cut < 0) {
+            int any_slipping = 0;
+            for (long j = 0; j < n && !any_slipping; ++j)
+                any_slipping = !bk_scene_stuck(scene, (size_t)j);
+            if (any_slipping)
+                return found_island(ctx, 0, n - 1, t);
+            for (long j = 0; j < n; ++j)
+                make_quiet(ctx, (size_t)j, t);
+            return BK_OK;
+        }
+        lo = cut;
+        hi = cut + n - 1;
+    }
+    long group_lo = 0, group_hi = -2, next_quiet = lo; /* no group open: group_hi < group_lo */
+    int rc = BK_OK;
+    for (long j = lo; j <= hi && rc == BK_OK; ++j) {
+        if (bk_scene_stuck(scene, wrap(ctx, j)))
+            continue;
+        long run_lo = j;
+        while (j + 1 <= hi && !bk_scene_stuck(scene, wrap(ctx, j + 1)))
+            ++j;
+        if (group_hi >= group_lo && run_lo - group_hi == 2) {
+            group_hi = j; /* one stuck block between: the same island */
+            continue;
+        }
+        if (group_hi >= group_lo) {
+            long a = group_lo - 1, b = group_hi + 1;
+            if (!periodic(ctx)) {
+                a = a < 0 ? 0 : a;
+                b = b > n - 1 ? n - 1 : b;
+            }
+            for (long q = next_quiet; q < a; ++q)
+                make_quiet(ctx, wrap(ctx, q), t);
+            rc = found_island(ctx, a, b, t);
+            next_quiet = b + 1;
+        }
+        group_lo = run_lo;
+        group_hi = j;
+    }
+    if (rc == BK_OK && group_hi >= group_lo) {
+        long a = group_lo - 1, b = group_hi + 1;
+        if (!periodic(ctx)) {
+            a = a < 0 ? 0 : a;
+            b = b > n - 1 ? n - 1 : b;
+        }
+        for (long q = next_quiet; q < a; ++q)
+            make_quiet(ctx, wrap(ctx, q), t);
+        rc = found_island(ctx, a, b, t);
+        next_quiet = b + 1;
+    }
+    for (long q = next_quiet; rc == BK_OK && q <= hi; ++q)
+        make_quiet(ctx, wrap(ctx, q), t);
+    return rc;
+}
+
+/* Rebuild the partition around chain positions [lo, hi] (unwrapped) at t, after modes there
+ * changed: the range grows by one block each way and by every island it touches (dissolved
+ * at t; the one whose increments were already taken is `taken`). */
+static int repartition(run_ctx *ctx, long lo, long hi, double t, size_t taken)
+{
+    bk_scene *scene = &ctx->scene;
+    long n = (long)scene->n;
+    lo -= 1;
+    hi += 1;
+    if (!periodic(ctx)) {
+        lo = lo < 0 ? 0 : lo;
+        hi = hi > n - 1 ? n - 1 : hi;
+    }
+    int rc = BK_OK;
+    /* On a ring the range may come round to cover it all: then everything is rebuilt. */
+    for (long j = lo; j <= hi && (!periodic(ctx) || hi - lo + 1 < n); ++j) {
+        size_t id = scene->island_of[wrap(ctx, j)];
+        if (id == BK_NO_ISLAND)
+            continue;
+        const bk_island *island = &ctx->islands[id]->island;
+        long offset = (long)wrap(ctx, (long)wrap(ctx, j) - (long)island->start);
+        long first = j - offset, last = first + (long)island->len - 1;
+        if ((rc = dissolve(ctx, id, t, id == taken)) != BK_OK)
+            return rc;
+        lo = first < lo ? first : lo;
+        hi = last > hi ? last : hi;
+    }
+    int whole_ring = periodic(ctx) && hi - lo + 1 >= n;
+    if (whole_ring)
+        for (size_t id = 0; id < ctx->islands_used && rc == BK_OK; ++id)
+            if (ctx->islands[id]->live)
+                rc = dissolve(ctx, id, t, id == taken);
+    return rc == BK_OK ? rebuild(ctx, lo, hi, whole_ring, t) : rc;
+}
+
+int bk_run_partition_all(run_ctx *ctx, double t)
+{
+    for (size_t id = 0; id < ctx->islands_used; ++id)
+        if (ctx->islands[id]->live) {
+            int rc = dissolve(ctx, id, t, 1);
+            if (rc != BK_OK)
+                return rc;
+        }
+    bk_heap_clear(&ctx->quiet);
+    long n = (long)ctx->scene.n;
+    return rebuild(ctx, 0, n - 1, periodic(ctx), t);
+}
+
+/* ------------------------------------------------------------- island events --- */
+
+typedef struct stop_probe {
+    run_ctx *ctx;
+    run_island *isl;
+    size_t block;
+    int status;
+} stop_probe;
+
+/* The stop root function of a slipping block on the island's last step's interpolant. */
+static double stop_function(double t, void *user)
+{
+    stop_probe *probe = user;
+    run_ctx *ctx = probe->ctx;
+    const bk_scene *scene = &ctx->scene;
+    size_t i = probe->block;
+    int rc = ctx->backend->interpolate(probe->isl->solver, t, probe->isl->y_probe, ctx->err);
+    if (rc != BK_OK) {
+        probe->status = rc;
+        return 0.0;
+    }
+    double slip_rate = (double)scene->mode[i] * probe->isl->y_probe[scene->slot[i] + 1];
+    double since = t - scene->t_switch[i];
+    if (scene->from_rest[i] && since <= 0.0)
+        return 1.0; /* the limit s a > 0 at the start of a slip from rest */
+    return scene->from_rest[i] ? slip_rate / since : slip_rate;
+}
+
+/* Locate the stop of block i hidden inside the island's last step before t_root. */
+static int locate_hidden_stop(run_ctx *ctx, run_island *isl, size_t i, double t_root, double *t_stop)
+{
+    double lo, hi;
+    ctx->backend->last_step(isl->solver, &lo, &hi);
+    if (lo < isl->island.t_ref)
+        lo = isl->island.t_ref;
+    stop_probe probe = {ctx, isl, i, BK_OK};
+    gsl_function fn = {stop_function, &probe};
+    double f_lo = stop_function(lo, &probe), f_hi = stop_function(t_root, &probe);
+    if (probe.status != BK_OK)
+        return probe.status;
+    if (f_hi >= 0.0 || f_lo <= 0.0) {
+        *t_stop = f_hi >= 0.0 ? t_root : lo;
+        return BK_OK;
+    }
+    gsl_root_fsolver *solver = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
+    if (!solver)
+        return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory locating a stop");
+    gsl_root_fsolver_set(solver, &fn, lo, t_root);
+    for (int iter = 0; iter < 200; ++iter) {
+        if (gsl_root_fsolver_iterate(solver) != GSL_SUCCESS)
+            break;
+        double a = gsl_root_fsolver_x_lower(solver), b = gsl_root_fsolver_x_upper(solver);
+        if (gsl_root_test_interval(a, b, 0.0, 4.0 * DBL_EPSILON) == GSL_SUCCESS)
+            break;
+    }
+    /* The upper end is past the zero: the state there has s v <= 0, as at a found root. */
+    *t_stop = gsl_root_fsolver_x_upper(solver);
+    gsl_root_fsolver_free(solver);
+    return probe.status;
+}
+
+/* The event an island's step just found at t_reached: a root (from_root), or a slipping
+ * block's velocity past zero at a step end although no root fired (a stop the root
+ * functions could not see, e.g. one masked at a restart).  A slip-rate minimum below zero,
+ * or that velocity, means the stop hid inside the step: the event moves back to it. */
+static int find_event(run_ctx *ctx, run_island *isl, double t_root, int from_root)
+{
+    const bk_scene *scene = &ctx->scene;
+    const bk_island *island = &isl->island;
+    size_t R = scene->roots_per_block, n_roots = bk_island_n_roots(island);
+    if (from_root) {
+        if (ctx->backend->root_info(isl->solver, isl->found) != BK_OK)
+            return BK_FAIL(ctx->err, BK_ERR_SOLVER, "cannot read root information at t = %.17g s", t_root);
+    } else {
+        memset(isl->found, 0, n_roots * sizeof *isl->found);
+    }
+    double t_hidden = t_root;
+    size_t hidden_block = SIZE_MAX;
+    for (size_t k = 0; k < island->len; ++k) {
+        size_t i = bk_island_block(island, k);
+        if (bk_scene_stuck(scene, i) || !scene->can_stick[i] || isl->found[R * k + BK_ROOT_MAIN])
+            continue;
+        if (from_root && !isl->found[R * k + BK_ROOT_EXTREMUM])
+            continue;
+        double slip_rate = (double)scene->mode[i] * isl->y[scene->slot[i] + 1];
+        if (from_root ? slip_rate > 0.0 : slip_rate >= 0.0)
+            continue;
+        double t_stop = t_root;
+        int rc = locate_hidden_stop(ctx, isl, i, t_root, &t_stop);
+        if (rc != BK_OK)
+            return rc;
+        if (t_stop < t_hidden || hidden_block == SIZE_MAX) {
+            t_hidden = t_stop;
+            hidden_block = i;
+        }
+    }
+    isl->pending = 1;
+    isl->from_root = from_root;
+    isl->hidden_block = hidden_block;
+    isl->t_event = hidden_block != SIZE_MAX ? t_hidden : t_root;
+    return BK_OK;
+}
+
+static int check_finite(run_ctx *ctx, const run_island *isl, double t)
+{
+    for (size_t k = 0; k < isl->island.n_y; ++k)
+        if (!isfinite(isl->y[k]))
+            return BK_FAIL(ctx->err, BK_ERR_NUMERIC,
+                           "non-finite value in the solution at t = %.17g s (component %zu)", t, k);
+    return BK_OK;
+}
+
+/* A slipping block whose velocity is past zero at a step end without a root. */
+static int missed_stop(const run_ctx *ctx, const run_island *isl)
+{
+    const bk_scene *scene = &ctx->scene;
+    for (size_t k = 0; k < isl->island.n_active; ++k) {
+        size_t i = isl->island.active[k];
+        if (scene->can_stick[i] && (double)scene->mode[i] * isl->y[scene->slot[i] + 1] < 0.0)
+            return 1;
+    }
+    return 0;
+}
+
+int bk_run_island_step(run_ctx *ctx, size_t id)
+{
+    run_island *isl = ctx->islands[id];
+    double t_reached;
+    int step = ctx->backend->step(isl->solver, &t_reached, isl->y, ctx->err);
+    if (step < 0)
+        return step;
+    isl->stepped = 1;
+    isl->t_reached = t_reached;
+    int rc = check_finite(ctx, isl, t_reached);
+    if (rc != BK_OK)
+        return rc;
+    if (++ctx->steps_since_row > ctx->options.max_steps)
+        return BK_FAIL(ctx->err, BK_ERR_MAX_STEPS,
+                       "more than %ld solver steps since the last output row or transition "
+                       "(t = %.17g s, now at t = %.17g s); raise [solver] max_steps or loosen rtol",
+                       ctx->options.max_steps, ctx->t_last_row, t_reached);
+    if (step == BK_STEP_ROOT) {
+        rc = find_event(ctx, isl, t_reached, 1);
+    } else {
+        if (ctx->options.min_step > 0.0 && step == BK_STEP_OK) {
+            double lo, hi;
+            ctx->backend->last_step(isl->solver, &lo, &hi);
+            if (hi - lo < ctx->options.min_step)
+                return BK_FAIL(ctx->err, BK_ERR_SOLVER,
+                               "the step size fell to %.3g s, below [solver] min_step = %g s, at t = %.17g s",
+                               hi - lo, ctx->options.min_step, t_reached);
+        }
+        bk_island_arm(&isl->island, t_reached, isl->y);
+        if (missed_stop(ctx, isl))
+            rc = find_event(ctx, isl, t_reached, 0);
+    }
+    if (rc != BK_OK)
+        return rc;
+    bk_heap_set(&ctx->island_queue, id, island_key(isl));
+    /* Every step, so that a wall-clock limit bites inside long segments. */
+    return bk_run_report_progress(ctx, t_reached);
+}
+
+int bk_run_apply_event(run_ctx *ctx, double t, size_t i, bk_mode_event event)
+{
+    bk_scene *scene = &ctx->scene;
+    double driver_pos = bk_driver_position(&ctx->model->driver, t);
+    double force = bk_scene_applied_force(scene, i, driver_pos);
+    bk_mode from = (bk_mode)scene->mode[i];
+    bk_mode to = bk_mode_next(from, event, force, bk_scene_static_threshold(scene, i));
+    scene->v[i] = 0.0;
+    if (to != BK_MODE_STICK) {
+        scene->t_switch[i] = t;
+        scene->from_rest[i] = 1;
+    }
+    if (from == BK_MODE_STICK && to != BK_MODE_STICK)
+        bk_run_leave_stuck(ctx, i, t);
+    scene->mode[i] = (int8_t)to;
+    if (from != BK_MODE_STICK && to == BK_MODE_STICK)
+        bk_run_enter_stuck(ctx, i, t);
+    if (to == from)
+        return 0;
+    int rc = bk_run_record_transition(ctx, t, i, from, to, force);
+    return rc < 0 ? rc : 1;
+}
+
+int bk_run_island_event(run_ctx *ctx, size_t id)
+{
+    run_island *isl = ctx->islands[id];
+    const bk_scene *scene = &ctx->scene;
+    size_t R = scene->roots_per_block;
+    double t = isl->t_event;
+    double work, dissipation;
+    int rc = unpack_island(ctx, isl, t, &work, &dissipation);
+    if (rc != BK_OK)
+        return rc;
+    ctx->work_closed += work;
+    ctx->dissipation_closed += dissipation;
+    const bk_island *island = &isl->island;
+    /* Every root restarts the island.  A minimum that hid no stop disarms its root until the
+     * block decelerates again, so the restart does not begin on a zero of it. */
+    if (isl->hidden_block == SIZE_MAX)
+        for (size_t k = 0; k < island->len; ++k)
+            if (isl->found[R * k + BK_ROOT_EXTREMUM])
+                ctx->scene.extremum_armed[bk_island_block(island, k)] = 0;
+    /* After a rewind only the hidden stop happened at t; otherwise every root that fired at
+     * the root's time is handled now, or its function would restart past its zero and be
+     * lost. */
+    int rewound = t < isl->t_reached;
+    int changed = 0;
+    for (size_t k = 0; k < island->len; ++k) {
+        size_t i = bk_island_block(island, k);
+        int fired = i == isl->hidden_block || (!rewound && isl->found[R * k + BK_ROOT_MAIN] != 0);
+        if (!fired)
+            continue;
+        bk_mode_event event = bk_scene_stuck(scene, i) ? BK_EVENT_BREAKAWAY : BK_EVENT_STOP;
+        rc = bk_run_apply_event(ctx, t, i, event);
+        if (rc < 0)
+            return rc;
+        changed |= rc;
+    }
+    isl->pending = 0;
+    if (changed && ctx->event_rows)
+        ctx->t_row_due = t;
+    if (!changed)
+        return start_island(ctx, id, t);
+    long lo = (long)island->start;
+    return repartition(ctx, lo, lo + (long)island->len - 1, t, id);
+}
+
+static int by_block(const void *a, const void *b)
+{
+    size_t x = *(const size_t *)a, y = *(const size_t *)b;
+    return (x > y) - (x < y);
+}
+
+int bk_run_quiet_failures(run_ctx *ctx, double t)
+{
+    bk_scene *scene = &ctx->scene;
+    const bk_model *model = ctx->model;
+    /* Every block whose breakaway falls on this instant (to rounding) slips now. */
+    double limit = t + SIMULTANEOUS_EPS * fabs(t);
+    size_t count = 0;
+    while (!bk_heap_empty(&ctx->quiet) && bk_heap_top_key(&ctx->quiet) <= limit)
+        ctx->batch[count++] = bk_heap_pop(&ctx->quiet);
+    qsort(ctx->batch, count, sizeof *ctx->batch, by_block);
+    double driver_pos = bk_driver_position(&model->driver, t);
+    /* The force crosses the threshold the way the driver pulls; passing that direction
+     * instead of the force itself is immune to rounding at the threshold. */
+    double pull = bk_driver_velocity(&model->driver, t) > 0.0 ? 1.0 : -1.0;
+    for (size_t k = 0; k < count; ++k) {
+        size_t i = ctx->batch[k];
+        bk_scene_age(scene, i, t);
+        double force = bk_scene_applied_force(scene, i, driver_pos);
+        bk_mode from = (bk_mode)scene->mode[i];
+        bk_mode to = bk_mode_next(from, BK_EVENT_BREAKAWAY, pull, 0.0);
+        bk_run_leave_stuck(ctx, i, t);
+        scene->mode[i] = (int8_t)to;
+        scene->t_switch[i] = t;
+        scene->from_rest[i] = 1;
+        int rc = bk_run_record_transition(ctx, t, i, from, to, force);
+        if (rc != BK_OK)
+            return rc;
+    }
+    ctx->stats->stuck_jumps++;
+    if (count > 0 && ctx->event_rows)
+        ctx->t_row_due = t;
+    for (size_t k = 0; k < count; ++k) {
+        size_t i = ctx->batch[k];
+        if (scene->island_of[i] != BK_NO_ISLAND)
+            continue; /* joined the island of a block that failed before it */
+        int rc = repartition(ctx, (long)i, (long)i, t, BK_NO_ISLAND);
+        if (rc != BK_OK)
+            return rc;
+    }
+    return BK_OK;
+}

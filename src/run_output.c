@@ -1,0 +1,254 @@
+/* What a run hands to its sink, and the books behind it: time-series rows, transitions (in
+ * block order within an instant), the energy audit's running totals, statistics, and
+ * checkpoints with the resume that continues from them.
+ *
+ * Energy.  The driver's work on a stuck block is the energy its driver spring gains (the
+ * block does not move), so each stuck interval's work is known in closed form when it ends,
+ * and a slipping block's work and dissipation are integrated by its island.  The totals are
+ * kept as what has finished plus what is open, so an event costs O(1) in the books and
+ * only a row (O(N) anyway) sums the open stuck intervals. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "run_impl.h"
+
+int bk_run_emit_row(run_ctx *ctx, double t, int is_event)
+{
+    const bk_model *model = ctx->model;
+    bk_scene *scene = &ctx->scene;
+    double driver_pos = bk_driver_position(&model->driver, t);
+    for (size_t i = 0; i < scene->n; ++i) {
+        ctx->friction[i] = bk_scene_friction(scene, i, driver_pos);
+        ctx->cof[i] = ctx->friction[i] / scene->normal[i];
+    }
+    if (model->n_friction_state > 0)
+        for (size_t i = 0; i < scene->n; ++i)
+            bk_scene_state_at_rest(scene, i, t, &ctx->state_out[model->blocks[i].state_offset]);
+    bk_sample sample = {
+        .t = t,
+        .driver = driver_pos,
+        .n_blocks = scene->n,
+        .x = scene->x,
+        .v = scene->v,
+        .friction = ctx->friction,
+        .cof = ctx->cof,
+        .mode = scene->mode,
+        .friction_state = model->n_friction_state ? ctx->state_out : NULL,
+        .kinetic_energy = bk_model_kinetic_energy(model, scene->v),
+        .elastic_energy = bk_model_elastic_energy(model, scene->x, driver_pos),
+        .work_driver = ctx->work,
+        .dissipation = ctx->dissipation,
+        .is_event = is_event,
+    };
+    /* Rows can come without steps (all stuck, or dense sampling): a stop request and the
+     * wall clock are checked here too, before the row counts as written. */
+    int rc = bk_run_report_progress(ctx, t);
+    if (rc != BK_OK)
+        return rc;
+    ctx->t_last_row = t;
+    ctx->steps_since_row = 0;
+    ctx->stats->rows++;
+    if (ctx->sink && ctx->sink->sample) {
+        rc = ctx->sink->sample(ctx->sink->self, &sample, ctx->err);
+        if (rc != BK_OK)
+            return rc < 0 ? rc : BK_ERR_SINK;
+    }
+    return BK_OK;
+}
+
+int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_mode to,
+                             double applied_force)
+{
+    bk_scene *scene = &ctx->scene;
+    if (t - ctx->last_transition[i] <= ctx->instant_window)
+        ctx->instant_count[i]++;
+    else
+        ctx->instant_count[i] = 1;
+    ctx->last_transition[i] = t;
+    if (ctx->instant_count[i] > ctx->options.max_transitions_per_instant)
+        return BK_FAIL(ctx->err, BK_ERR_ZENO,
+                       "block %zu: more than %ld transitions within %.3g s at t = %.17g s "
+                       "(chattering or Zeno behaviour; last %s -> %s, applied force %.6g N, "
+                       "static threshold %.6g N); see [solver] max_transitions_per_instant",
+                       i, ctx->options.max_transitions_per_instant, ctx->instant_window, t,
+                       bk_mode_name(from), bk_mode_name(to), applied_force,
+                       bk_scene_static_threshold(scene, i));
+    ctx->stats->transitions++;
+    ctx->steps_since_row = 0;
+    if (!ctx->config->output.transitions || !ctx->sink || !ctx->sink->transition)
+        return BK_OK;
+    if (ctx->n_instant > 0 && t != ctx->t_instant) {
+        int rc = bk_run_flush_instant(ctx);
+        if (rc != BK_OK)
+            return rc;
+    }
+    if (ctx->n_instant == ctx->instant_capacity) {
+        size_t cap = ctx->instant_capacity ? 2 * ctx->instant_capacity : 16;
+        bk_transition *grown = realloc(ctx->instant, cap * sizeof *grown);
+        if (!grown)
+            return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the transitions of t = %.17g s", t);
+        ctx->instant = grown;
+        ctx->instant_capacity = cap;
+    }
+    ctx->t_instant = t;
+    ctx->instant[ctx->n_instant++] = (bk_transition){
+        .t = t,
+        .block = (int32_t)i,
+        .from = (int8_t)from,
+        .to = (int8_t)to,
+        .x = scene->x[i],
+        .v = scene->v[i],
+        .force = applied_force,
+    };
+    return BK_OK;
+}
+
+int bk_run_flush_instant(run_ctx *ctx)
+{
+    size_t n = ctx->n_instant;
+    ctx->n_instant = 0;
+    /* Insertion sort by block, stable: one block's transitions keep their order, and an
+     * instant holds a handful (or a uniform chain's synchronous slip, in order already). */
+    for (size_t k = 1; k < n; ++k) {
+        bk_transition moving = ctx->instant[k];
+        size_t j = k;
+        for (; j > 0 && ctx->instant[j - 1].block > moving.block; --j)
+            ctx->instant[j] = ctx->instant[j - 1];
+        ctx->instant[j] = moving;
+    }
+    for (size_t k = 0; k < n; ++k) {
+        int rc = ctx->sink->transition(ctx->sink->self, &ctx->instant[k], ctx->err);
+        if (rc != BK_OK)
+            return rc < 0 ? rc : BK_ERR_SINK;
+    }
+    return BK_OK;
+}
+
+void bk_run_leave_stuck(run_ctx *ctx, size_t i, double t)
+{
+    double driver_pos = bk_driver_position(&ctx->model->driver, t);
+    ctx->work_closed += bk_scene_driver_spring_energy(&ctx->scene, i, driver_pos) - ctx->spring_energy_ref[i];
+}
+
+void bk_run_enter_stuck(run_ctx *ctx, size_t i, double t)
+{
+    double driver_pos = bk_driver_position(&ctx->model->driver, t);
+    ctx->spring_energy_ref[i] = bk_scene_driver_spring_energy(&ctx->scene, i, driver_pos);
+}
+
+void bk_run_energy_totals(run_ctx *ctx, double t, double island_work, double island_dissipation)
+{
+    const bk_scene *scene = &ctx->scene;
+    double driver_pos = bk_driver_position(&ctx->model->driver, t);
+    double open = 0.0;
+    for (size_t i = 0; i < scene->n; ++i)
+        if (bk_scene_stuck(scene, i))
+            open += bk_scene_driver_spring_energy(scene, i, driver_pos) - ctx->spring_energy_ref[i];
+    ctx->work = ctx->work_closed + island_work + open;
+    ctx->dissipation = ctx->dissipation_closed + island_dissipation;
+}
+
+void bk_run_rebase_energy(run_ctx *ctx, double t)
+{
+    bk_scene *scene = &ctx->scene;
+    ctx->work_closed = ctx->work;
+    ctx->dissipation_closed = ctx->dissipation;
+    for (size_t i = 0; i < scene->n; ++i)
+        if (bk_scene_stuck(scene, i)) {
+            bk_run_enter_stuck(ctx, i, t);
+            if (scene->island_of[i] == BK_NO_ISLAND)
+                bk_scene_age(scene, i, t);
+        }
+}
+
+void bk_run_collect_stats(const run_ctx *ctx, bk_run_stats *stats, double cpu0)
+{
+    const bk_run_stats *base = &ctx->base;
+    bk_solver_counters c;
+    bk_run_solver_counters(ctx, &c);
+    stats->steps = base->steps + c.steps;
+    stats->rhs_evals = base->rhs_evals + c.rhs_evals;
+    stats->root_evals = base->root_evals + c.root_evals;
+    stats->err_test_fails = base->err_test_fails + c.err_test_fails;
+    stats->nonlin_iters = base->nonlin_iters + c.nonlin_iters;
+    stats->t_reached = ctx->t_last_row;
+    stats->wall_time = base->wall_time + (bk_run_wall_seconds() - ctx->wall_start);
+    stats->cpu_time = base->cpu_time + (double)(clock() - (clock_t)cpu0) / CLOCKS_PER_SEC;
+}
+
+int bk_run_checkpoint(run_ctx *ctx, double t)
+{
+    int rc = bk_run_unpack_all(ctx, t);
+    if (rc != BK_OK)
+        return rc;
+    bk_run_rebase_energy(ctx, t);
+    ctx->next_checkpoint++;
+    if (ctx->sink && ctx->sink->checkpoint) {
+        bk_scene *scene = &ctx->scene;
+        bk_checkpoint cp = {
+            .t = t,
+            .n_blocks = scene->n,
+            .n_state = ctx->model->n_friction_state,
+            .mode = scene->mode,
+            .x = scene->x,
+            .v = scene->v,
+            .state = scene->state,
+            .t_switch = scene->t_switch,
+            .from_rest = scene->from_rest,
+            .extremum_armed = scene->extremum_armed,
+            .last_transition = ctx->last_transition,
+            .instant_count = ctx->instant_count,
+            .next_sample = ctx->next_sample,
+            .work_driver = ctx->work,
+            .dissipation = ctx->dissipation,
+            .elastic_initial = ctx->elastic0,
+            .kinetic_initial = ctx->kinetic0,
+            .t_last_row = ctx->t_last_row,
+            .steps_since_row = ctx->steps_since_row,
+        };
+        cp.stats = *ctx->stats;
+        bk_run_collect_stats(ctx, &cp.stats, ctx->cpu0);
+        rc = ctx->sink->checkpoint(ctx->sink->self, &cp, ctx->err);
+        if (rc != BK_OK)
+            return rc < 0 ? rc : BK_ERR_SINK;
+    }
+    /* A checkpoint is a restart of everything, as a resumed run starts. */
+    return bk_run_partition_all(ctx, t);
+}
+
+int bk_run_resume(run_ctx *ctx, const bk_checkpoint *cp)
+{
+    bk_scene *scene = &ctx->scene;
+    size_t n = scene->n, n_state = ctx->model->n_friction_state;
+    if (cp->n_blocks != n || cp->n_state != n_state)
+        return BK_FAIL(ctx->err, BK_ERR_INVALID,
+                       "checkpoint of %zu blocks and %zu friction states does not fit this config (%zu, %zu)",
+                       cp->n_blocks, cp->n_state, n, n_state);
+    memcpy(scene->mode, cp->mode, n * sizeof *scene->mode);
+    memcpy(scene->x, cp->x, n * sizeof *scene->x);
+    memcpy(scene->x_ref, cp->x, n * sizeof *scene->x_ref);
+    memcpy(scene->v, cp->v, n * sizeof *scene->v);
+    memcpy(scene->state, cp->state, n_state * sizeof *scene->state);
+    memcpy(scene->t_switch, cp->t_switch, n * sizeof *scene->t_switch);
+    memcpy(scene->from_rest, cp->from_rest, n * sizeof *scene->from_rest);
+    memcpy(scene->extremum_armed, cp->extremum_armed, n * sizeof *scene->extremum_armed);
+    memcpy(ctx->last_transition, cp->last_transition, n * sizeof *ctx->last_transition);
+    memcpy(ctx->instant_count, cp->instant_count, n * sizeof *ctx->instant_count);
+    for (size_t i = 0; i < n; ++i)
+        scene->state_time[i] = cp->t;
+    ctx->work = cp->work_driver;
+    ctx->dissipation = cp->dissipation;
+    bk_run_rebase_energy(ctx, cp->t);
+    ctx->elastic0 = cp->elastic_initial;
+    ctx->kinetic0 = cp->kinetic_initial;
+    ctx->next_sample = cp->next_sample;
+    ctx->t_last_row = cp->t_last_row;
+    ctx->steps_since_row = cp->steps_since_row;
+    ctx->base = cp->stats;
+    *ctx->stats = cp->stats;
+    if (ctx->checkpoint_interval > 0.0)
+        ctx->next_checkpoint = (long)llround(cp->t / ctx->checkpoint_interval) + 1;
+    return BK_OK;
+}
