@@ -403,7 +403,9 @@ bk_config *bk_config_build(loader *ld)
     if (c->prescribed)
         o->fields &= ~(unsigned)BK_FIELD_ENERGY; /* no dynamics, no energies */
     o->transitions = (int)value_of(ld, "output", "transitions");
-    o->event_rows = (int)value_of(ld, "output", "event_rows");
+    double event_rows = value_of(ld, "output", "event_rows");
+    o->event_rows = isnan(event_rows) ? c->model && c->model->n_blocks <= BK_EVENT_ROWS_AUTO_BLOCKS
+                                      : (int)event_rows;
     o->checkpoint_interval = value_of(ld, "output", "checkpoint_interval");
     entry *checkpoints = bk_config_lookup(ld, "output", "checkpoint_interval");
     if (c->prescribed && checkpoints && o->checkpoint_interval > 0.0)

@@ -113,7 +113,10 @@ static const key_def keys[] = {
     {"output", {"fields", "", 0, 0, 0, 0, "per-row datasets: all, or a list of x v friction cof mode energy state"},
      BK_KEY_FIELDS, bk_output_field_names, NULL, "all"},
     {"output", {"transitions", "", 1, 0, 1, 0, "write the /transitions table"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
-    {"output", {"event_rows", "", 1, 0, 1, 0, "add a row at every transition instant"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
+    {"output", {"event_rows", "", NAN, 0, 1, 0,
+                "add a full row at every transition instant (an O(n_blocks) snapshot per event; the "
+                "/transitions table holds the changed block's state anyway); auto: true up to 16 blocks"},
+     BK_KEY_BOOLEAN, NULL, NULL, "auto"},
     NUM("output", "max_bytes", "B", 1e10, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
         "largest size the sample rows (t_end / interval, times the bytes per row for the fields and blocks) "
         "may take: a guard against a typo in interval or n_blocks"),
@@ -189,7 +192,7 @@ void bk_config_format_allowed(const key_def *def, const bk_param *param, char *b
         return;
     }
     if (def->type == BK_KEY_BOOLEAN) {
-        snprintf(buf, len, "true, false, yes, no, on, off, 1, 0");
+        snprintf(buf, len, "%strue, false, yes, no, on, off, 1, 0", isnan(param->default_value) ? "auto, " : "");
         return;
     }
     if (def->type == BK_KEY_TEXT) {

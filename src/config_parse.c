@@ -276,6 +276,11 @@ int bk_config_check_value(loader *ld, entry *e, const key_def *def, const bk_par
         return 0;
     }
     case BK_KEY_BOOLEAN:
+        /* A boolean whose default is decided per scene takes that decision by name. */
+        if (isnan(param->default_value) && strcmp(v, "auto") == 0) {
+            e->number = NAN;
+            return 0;
+        }
         if (parse_bool(v, &e->number)) {
             bk_config_report_entry(ld, e, "not a boolean: \"%s\" (allowed: %s)", v, allowed);
             return -1;

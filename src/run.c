@@ -29,6 +29,7 @@
 #include <gsl/gsl_errno.h>
 
 #include "method_choice.h"
+#include "output/layout.h"
 #include "prescribed.h"
 #include "run_impl.h"
 
@@ -300,6 +301,9 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
     ctx.checkpoint_interval = config->output.checkpoint_interval;
     ctx.next_checkpoint = 1;
     ctx.t_row_due = NAN;
+    ctx.max_bytes = config->output.max_bytes > 0.0 ? config->output.max_bytes : INFINITY;
+    ctx.row_bytes = bk_output_row_bytes(config->output.fields, config->model->n_blocks,
+                                        config->model->n_friction_state);
     ctx.t_instant = NAN;
     memset(ctx.stats, 0, sizeof *ctx.stats);
     snprintf(ctx.stats->method, sizeof ctx.stats->method, "%s", config->solver.method);

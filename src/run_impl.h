@@ -73,6 +73,9 @@ typedef struct run_ctx {
     /* An event row owed for the instant at t_row_due (NAN: none). */
     double t_row_due;
 
+    /* What the rows and transitions take on disk, against [output] max_bytes. */
+    double bytes_written, row_bytes, max_bytes;
+
     /* Row buffers. */
     double *friction, *cof, *state_out;
 

@@ -12,7 +12,23 @@
 #include <string.h>
 #include <time.h>
 
+#include "output/layout.h"
 #include "run_impl.h"
+
+/* The [output] max_bytes guard counts what is written, event rows and transitions too:
+ * their number is not known before the run. */
+static int count_bytes(run_ctx *ctx, double bytes, double t)
+{
+    ctx->bytes_written += bytes;
+    if (ctx->bytes_written <= ctx->max_bytes)
+        return BK_OK;
+    return BK_FAIL(ctx->err, BK_ERR_LIMIT,
+                   "[output] max_bytes = %.3g B reached at t = %.17g s: %ld rows of %.3g B and %ld "
+                   "transitions of %d B; raise max_bytes, sample less often, or write no event rows "
+                   "([output] event_rows = false)",
+                   ctx->max_bytes, t, ctx->stats->rows, ctx->row_bytes, ctx->stats->transitions,
+                   BK_TRANSITION_RECORD_BYTES);
+}
 
 int bk_run_emit_row(run_ctx *ctx, double t, int is_event)
 {
@@ -50,6 +66,8 @@ int bk_run_emit_row(run_ctx *ctx, double t, int is_event)
     ctx->t_last_row = t;
     ctx->steps_since_row = 0;
     ctx->stats->rows++;
+    if ((rc = count_bytes(ctx, ctx->row_bytes, t)) != BK_OK)
+        return rc;
     if (ctx->sink && ctx->sink->sample) {
         rc = ctx->sink->sample(ctx->sink->self, &sample, ctx->err);
         if (rc != BK_OK)
@@ -79,6 +97,9 @@ int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_
     ctx->steps_since_row = 0;
     if (!ctx->config->output.transitions || !ctx->sink || !ctx->sink->transition)
         return BK_OK;
+    int limit = count_bytes(ctx, BK_TRANSITION_RECORD_BYTES, t);
+    if (limit != BK_OK)
+        return limit;
     if (ctx->n_instant > 0 && t != ctx->t_instant) {
         int rc = bk_run_flush_instant(ctx);
         if (rc != BK_OK)

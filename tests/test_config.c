@@ -124,7 +124,39 @@ static void test_defaults(void **state)
     assert_close(c->output.interval, 5e-3, 1e-15, 0); /* t_end / 1000 */
     assert_int_equal(c->output.fields, BK_FIELD_ALL);
     assert_int_equal(c->output.transitions, 1);
+    assert_int_equal(c->output.event_rows, 1); /* auto: a short chain gets event rows */
     bk_config_free(c);
+}
+
+/* event_rows = auto (the default, or by name) writes full rows at transitions on chains of
+ * up to BK_EVENT_ROWS_AUTO_BLOCKS blocks and none on longer ones; true and false win. */
+static void test_event_rows_auto(void **state)
+{
+    (void)state;
+    const struct {
+        const char *n_blocks, *event_rows;
+        int expected;
+    } cases[] = {
+        {"model.n_blocks=16", NULL, 1},          {"model.n_blocks=17", NULL, 0},
+        {"model.n_blocks=1000", "output.event_rows=auto", 0},
+        {"model.n_blocks=1000", "output.event_rows=true", 1},
+        {"model.n_blocks=2", "output.event_rows=off", 0},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; ++k) {
+        const char *overrides[2] = {cases[k].n_blocks, cases[k].event_rows};
+        bk_config *c = NULL;
+        bk_error err = {0};
+        int rc = bk_config_load_string(minimal_config, "auto.ini", overrides, cases[k].event_rows ? 2 : 1, &c, &err);
+        if (rc != BK_OK)
+            fail_msg("%s", err.message);
+        assert_int_equal(c->output.event_rows, cases[k].expected);
+        bk_config_free(c);
+    }
+    const char *bad[] = {"output.event_rows=sometimes"};
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(minimal_config, "auto.ini", bad, 1, &c, &err), BK_ERR_CONFIG);
+    assert_non_null(strstr(err.message, "(allowed: auto, true, false, yes, no, on, off, 1, 0)"));
 }
 
 /* Indented keys, a 190-character line, CRLF line ends and ';' comments are all fine. */
@@ -457,6 +489,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_full_config),
         cmocka_unit_test(test_defaults),
+        cmocka_unit_test(test_event_rows_auto),
         cmocka_unit_test(test_tolerated_forms),
         cmocka_unit_test(test_rejections),
         cmocka_unit_test(test_first_error_reported),

@@ -442,6 +442,152 @@ static void test_auto_method(void **state)
     }
 }
 
+/* --- islands ---------------------------------------------------------------------------- */
+
+/* A uniform 60-block chain with blocks 10-12 pulled back (and, in the second run, blocks
+ * 45-47 as well): the first group fails early and slips while everything else holds.  Its
+ * transitions come out the same to the last bit whether or not the far group slips at the
+ * same times, with every back-end family: islands do not force each other's steps. */
+static bk_config *two_groups_config(const char *method, int both)
+{
+    scene_spec spec = {.n = 60, .mass = 1.0, .stiffness = 1e4, .coupling = 2e4, .mu_s = 0.6,
+                       .mu_d = 0.5, .velocity = 1e-3, .t_end = 0.58, .rtol = 1e-8,
+                       .interval = 0.0, .spring = BK_SPRING_LINEAR,
+                       .boundary = BK_BOUNDARY_FREE, .method = method, .detect_extrema = 1,
+                       .max_per_instant = 100};
+    bk_config *c = scene_config(&spec);
+    /* Before t_end every unperturbed block stays stuck: they fail at 0.5886 s. */
+    const double pulled_back[3] = {-1.3e-5, -2.1e-5, -0.7e-5};
+    for (size_t k = 0; k < 3; ++k) {
+        c->model->blocks[10 + k].x_init = pulled_back[k];
+        if (both)
+            c->model->blocks[45 + k].x_init = pulled_back[k];
+    }
+    return c;
+}
+
+static void test_distant_groups_independent(void **state)
+{
+    (void)state;
+    const char *methods[] = {"exact", "gsl_rk8pd", "cvode_adams", "cvode_bdf"};
+    for (size_t m = 0; m < sizeof methods / sizeof *methods; ++m) {
+        recorder alone = {0}, together = {0};
+        bk_error err = {0};
+        bk_config *c = two_groups_config(methods[m], 0);
+        int rc = run_recorded(c, &alone, NULL, &err);
+        bk_config_free(c);
+        if (rc != BK_OK)
+            fail_msg("%s: %s", methods[m], err.message);
+        c = two_groups_config(methods[m], 1);
+        rc = run_recorded(c, &together, NULL, &err);
+        bk_config_free(c);
+        if (rc != BK_OK)
+            fail_msg("%s: %s", methods[m], err.message);
+        size_t near = 0, far = 0, between = 0;
+        for (size_t k = 0; k < together.n_transitions; ++k) {
+            int32_t b = together.transitions[k].block;
+            far += b >= 40;
+            between += b >= 25 && b < 35;
+        }
+        assert_int_equal(between, 0); /* the groups never met */
+        assert_true(far > 4);
+        for (size_t k = 0; k < together.n_transitions; ++k) {
+            const bk_transition *t = &together.transitions[k];
+            if (t->block >= 30)
+                continue;
+            if (near >= alone.n_transitions)
+                fail_msg("%s: more near transitions with the far group slipping", methods[m]);
+            const bk_transition *a = &alone.transitions[near++];
+            if (a->t != t->t || a->block != t->block || a->from != t->from || a->to != t->to ||
+                a->x != t->x || a->v != t->v || a->force != t->force)
+                fail_msg("%s: transition %zu differs: block %d at %.17g s alone, block %d at "
+                         "%.17g s with the far group", methods[m], near - 1, (int)a->block, a->t,
+                         (int)t->block, t->t);
+        }
+        assert_int_equal(near, alone.n_transitions);
+        assert_true(near > 4);
+        print_message("%s: %zu near transitions identical, %zu far ones alongside\n", methods[m],
+                      near, far);
+        recorder_free(&alone);
+        recorder_free(&together);
+    }
+}
+
+/* [output] max_bytes counts everything written: full event rows on a 20-block chain pass
+ * the limit that the transitions table alone stays under. */
+static void test_output_limit_counts_event_rows(void **state)
+{
+    (void)state;
+    scene_spec spec = {.n = 20, .mass = 1.0, .stiffness = 1e4, .coupling = 2e4, .mu_s = 0.6,
+                       .mu_d = 0.5, .velocity = 1e-3, .t_end = 0.8, .rtol = 1e-8,
+                       .interval = 0.0, .spring = BK_SPRING_LINEAR,
+                       .boundary = BK_BOUNDARY_FREE, .method = "exact", .detect_extrema = 1,
+                       .max_per_instant = 100};
+    for (int rows = 0; rows < 2; ++rows) {
+        bk_config *c = scene_config(&spec);
+        for (size_t i = 0; i < 20; ++i)
+            c->model->blocks[i].x_init = 1e-6 * (double)((i * 7) % 5);
+        c->output.event_rows = rows;
+        c->output.max_bytes = 2e4;
+        recorder r = {0};
+        bk_error err = {0};
+        bk_run_stats stats;
+        int rc = run_recorded(c, &r, &stats, &err);
+        if (rows) {
+            assert_int_equal(rc, BK_ERR_LIMIT);
+            assert_non_null(strstr(err.message, "[output] max_bytes = 2e+04 B reached"));
+            assert_non_null(strstr(err.message, "event_rows = false"));
+        } else {
+            if (rc != BK_OK)
+                fail_msg("%s", err.message);
+            /* 2 rows of 17 + 33 x 20 + 32 bytes and 38 per transition fit. */
+            assert_true(stats.transitions > 50);
+            assert_true(2.0 * 709.0 + 38.0 * (double)stats.transitions <= 2e4);
+        }
+        recorder_free(&r);
+        bk_config_free(c);
+    }
+}
+
+/* A resting rate-and-state block ages (theta = theta0 + B t, so its threshold grows) while
+ * the driver loads it: its breakaway, found in closed form without an integrator, is the
+ * first zero of threshold(theta(t)) - k V t, computed here by bisection. */
+static void test_aging_breakaway(void **state)
+{
+    (void)state;
+    const char *text = "[model]\nn_blocks = 1\n[block]\nmass = 1\ndriver_stiffness = 1e4\n"
+                       "[friction]\nlaw = rate_state\nmu_s = 0.6\nmu_d = 0.5\n"
+                       "[driver]\nvelocity = 1e-3\n[output]\ninterval = 0\n[run]\nt_end = 1\n";
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(text, "aging.ini", NULL, 0, &c, &err), BK_OK);
+    const bk_block *b = &c->model->blocks[0];
+    const bk_friction_law *law = b->law;
+    double theta0, rate;
+    law->state_init(b->friction_params, &theta0);
+    law->state_rate(b->friction_params, 0.0, &theta0, &rate);
+    double lo = 0.0, hi = 1.0;
+    for (int iter = 0; iter < 200; ++iter) {
+        double mid = 0.5 * (lo + hi), theta = theta0 + rate * mid;
+        double margin = law->static_threshold(b->friction_params, b->normal_force, &theta) -
+                        b->driver_stiffness * 1e-3 * mid;
+        *(margin > 0.0 ? &lo : &hi) = mid;
+    }
+    recorder r = {0};
+    int rc = run_recorded(c, &r, NULL, &err);
+    if (rc != BK_OK)
+        fail_msg("%s", err.message);
+    assert_true(r.n_transitions >= 1);
+    assert_int_equal(r.transitions[0].to, BK_MODE_SLIP_POS);
+    assert_close(r.transitions[0].t, hi, 1e-14, 0.0);
+    /* The aging made it later than the fresh contact's threshold would. */
+    double fresh = law->static_threshold(b->friction_params, b->normal_force, &theta0) /
+                   (b->driver_stiffness * 1e-3);
+    assert_true(r.transitions[0].t > fresh * (1.0 + 1e-6));
+    recorder_free(&r);
+    bk_config_free(c);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -464,6 +610,9 @@ int main(void)
         cmocka_unit_test(test_rows),
         cmocka_unit_test(test_per_block_laws),
         cmocka_unit_test(test_auto_method),
+        cmocka_unit_test(test_distant_groups_independent),
+        cmocka_unit_test(test_output_limit_counts_event_rows),
+        cmocka_unit_test(test_aging_breakaway),
     };
     return cmocka_run_group_tests_name("run", tests, NULL, NULL);
 }

@@ -40,15 +40,23 @@ typedef struct bk_solver_options {
                                the method's own (Zonneveld 5_3_4, SDIRK 5_3_4) */
 } bk_solver_options;
 
+/* A full row at every transition instant costs (17 + 33 N) bytes for N blocks, against the
+ * 38 of the transition record: cheap on short chains, where figures want it, an O(N)
+ * snapshot per event on long ones.  event_rows = auto turns it on up to this many blocks. */
+#define BK_EVENT_ROWS_AUTO_BLOCKS 16
+
 typedef struct bk_output_options {
     char *path;        /* HDF5 output path, owned; default "<config stem>.h5" */
     double interval;   /* s between samples; 0 = transition rows only; default t_end/1000 */
     unsigned fields;   /* BK_FIELD_* mask; default all */
     int transitions;   /* write /transitions; default 1 */
-    int event_rows;    /* add a row at every transition instant; default 1 */
+    int event_rows;    /* add a row at every transition instant; default (auto): 1 for chains
+                          of up to BK_EVENT_ROWS_AUTO_BLOCKS blocks, else 0 */
     double checkpoint_interval; /* s between checkpoints (restart points); 0 = none (default) */
     long max_rows;     /* sample rows t_end / interval may ask for; default 1e8 */
-    double max_bytes;  /* bytes those sample rows may take on disk (estimate); default 1e10 */
+    double max_bytes;  /* bytes the rows and transitions may take on disk: the sample rows
+                          checked at load, everything written checked during the run;
+                          default 1e10 (0 in a config built in code: no limit) */
 } bk_output_options;
 
 /* A prescribed-motion scene (no dynamics): one block slides at a piecewise-constant slip

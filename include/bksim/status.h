@@ -24,7 +24,8 @@
     X(BK_ERR_SINK, -10, "output sink failed")                                          \
     X(BK_ERR_INTERRUPTED, -11, "run interrupted")                                     \
     X(BK_ERR_INTERNAL, -12, "internal error")                                          \
-    X(BK_ERR_DAMAGED, -13, "damaged output file")
+    X(BK_ERR_DAMAGED, -13, "damaged output file")                                       \
+    X(BK_ERR_LIMIT, -14, "an output limit was reached")
 
 typedef enum bk_status {
 #define BK_STATUS_ENUM(name, value, text) name = value,

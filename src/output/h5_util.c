@@ -315,7 +315,7 @@ hid_t bk_h5_kind_mem_type(bk_series_kind kind)
 /* The transition record in memory (bk_transition) and on disk (packed little-endian). */
 hid_t bk_h5_transition_type(int on_disk)
 {
-    hid_t type = H5Tcreate(H5T_COMPOUND, on_disk ? 38 : sizeof(bk_transition));
+    hid_t type = H5Tcreate(H5T_COMPOUND, on_disk ? BK_TRANSITION_RECORD_BYTES : sizeof(bk_transition));
     if (type < 0)
         return type;
     herr_t rc;

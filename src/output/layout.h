@@ -34,6 +34,9 @@ extern const bk_series_def bk_series[BK_N_SERIES];
 /* The words of [output] fields, NULL-terminated: word i selects BK_FIELD bit 1 << i. */
 extern const char *const bk_output_field_names[];
 
+/* Bytes of one /transitions record on disk (packed: t, block, from, to, x, v, force). */
+#define BK_TRANSITION_RECORD_BYTES 38
+
 #define BK_TRANSITIONS_UNITS "t: s, block: 1, from: 1, to: 1, x: m, v: m/s, force: N"
 #define BK_TRANSITIONS_DESCRIPTION                                                         \
     "mode transitions: time, block (0-based), from/to mode (stick 0, slip+ 1, slip- -1), " \
