@@ -2,7 +2,7 @@
 # plain and under AddressSanitizer + UndefinedBehaviorSanitizer.
 
 CC       ?= gcc
-PKGS     := hdf5-serial gsl inih
+PKGS     := hdf5-serial gsl inih lapacke
 SUNDIALS := -lsundials_cvode -lsundials_ida -lsundials_arkode -lsundials_nvecserial \
             -lsundials_sunmatrixdense -lsundials_sunmatrixband \
             -lsundials_sunlinsoldense -lsundials_sunlinsolband \

@@ -89,7 +89,7 @@ static const key_def keys[] = {
     {"solver", {"max_step", "s", NAN, 0.0, INFINITY, BK_PARAM_DERIVED | BK_PARAM_MIN_EXCLUSIVE,
                 "largest integrator step (keeps a slip-rate extremum from hiding inside a step)"},
      BK_KEY_NUMBER, NULL, NULL, "1/8 of the fastest natural period"},
-    INT("solver", "max_steps", 100000, 1, INT_MAX, 0, "integrator steps allowed between two output rows"),
+    INT("solver", "max_steps", 100000, 1, INT_MAX, 0, "integrator steps allowed between two output rows or transitions (a hang guard)"),
     {"solver", {"detect_velocity_extrema", "", 1, 0, 1, 0,
                 "locate slip-rate minima to catch a stop hidden inside one step"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
     INT("solver", "max_transitions_per_instant", 100, 1, INT_MAX, 0,

@@ -16,18 +16,14 @@ int bk_heap_reserve(bk_heap *heap, size_t capacity)
 {
     if (capacity <= heap->capacity)
         return 0;
-    size_t *items = realloc(heap->items, capacity * sizeof *items);
-    if (!items)
+    bk_heap_entry *entries = realloc(heap->entries, capacity * sizeof *entries);
+    if (!entries)
         return -1;
-    heap->items = items;
+    heap->entries = entries;
     size_t *position = realloc(heap->position, capacity * sizeof *position);
     if (!position)
         return -1;
     heap->position = position;
-    double *key = realloc(heap->key, capacity * sizeof *key);
-    if (!key)
-        return -1;
-    heap->key = key;
     for (size_t i = heap->capacity; i < capacity; ++i)
         heap->position[i] = BK_HEAP_ABSENT;
     heap->capacity = capacity;
@@ -36,71 +32,69 @@ int bk_heap_reserve(bk_heap *heap, size_t capacity)
 
 void bk_heap_free(bk_heap *heap)
 {
-    free(heap->items);
+    free(heap->entries);
     free(heap->position);
-    free(heap->key);
     memset(heap, 0, sizeof *heap);
 }
 
 void bk_heap_clear(bk_heap *heap)
 {
     for (size_t k = 0; k < heap->count; ++k)
-        heap->position[heap->items[k]] = BK_HEAP_ABSENT;
+        heap->position[heap->entries[k].item] = BK_HEAP_ABSENT;
     heap->count = 0;
 }
 
-static int before(const bk_heap *heap, size_t a, size_t b)
+static int before(bk_heap_entry a, bk_heap_entry b)
 {
-    double ka = heap->key[a], kb = heap->key[b];
-    return ka < kb || (ka == kb && a < b);
+    return a.key < b.key || (a.key == b.key && a.item < b.item);
 }
 
-static void place(bk_heap *heap, size_t index, size_t item)
+static void place(bk_heap *heap, size_t index, bk_heap_entry entry)
 {
-    heap->items[index] = item;
-    heap->position[item] = index;
+    heap->entries[index] = entry;
+    heap->position[entry.item] = index;
 }
 
 static void sift_up(bk_heap *heap, size_t index)
 {
-    size_t item = heap->items[index];
+    bk_heap_entry entry = heap->entries[index];
     while (index > 0) {
         size_t parent = (index - 1) / 2;
-        if (!before(heap, item, heap->items[parent]))
+        if (!before(entry, heap->entries[parent]))
             break;
-        place(heap, index, heap->items[parent]);
+        place(heap, index, heap->entries[parent]);
         index = parent;
     }
-    place(heap, index, item);
+    place(heap, index, entry);
 }
 
 static void sift_down(bk_heap *heap, size_t index)
 {
-    size_t item = heap->items[index];
+    bk_heap_entry entry = heap->entries[index];
     for (;;) {
         size_t child = 2 * index + 1;
         if (child >= heap->count)
             break;
-        if (child + 1 < heap->count && before(heap, heap->items[child + 1], heap->items[child]))
+        if (child + 1 < heap->count && before(heap->entries[child + 1], heap->entries[child]))
             ++child;
-        if (!before(heap, heap->items[child], item))
+        if (!before(heap->entries[child], entry))
             break;
-        place(heap, index, heap->items[child]);
+        place(heap, index, heap->entries[child]);
         index = child;
     }
-    place(heap, index, item);
+    place(heap, index, entry);
 }
 
 void bk_heap_set(bk_heap *heap, size_t item, double key)
 {
     size_t index = heap->position[item];
-    heap->key[item] = key;
     if (index == BK_HEAP_ABSENT) {
         index = heap->count++;
-        place(heap, index, item);
+        place(heap, index, (bk_heap_entry){key, item});
         sift_up(heap, index);
         return;
     }
+    heap->entries[index].key = key;
     sift_up(heap, index);
     sift_down(heap, heap->position[item]);
 }
@@ -111,17 +105,17 @@ void bk_heap_remove(bk_heap *heap, size_t item)
     if (index == BK_HEAP_ABSENT)
         return;
     heap->position[item] = BK_HEAP_ABSENT;
-    size_t last = heap->items[--heap->count];
+    bk_heap_entry last = heap->entries[--heap->count];
     if (index == heap->count)
         return;
     place(heap, index, last);
     sift_up(heap, index);
-    sift_down(heap, heap->position[last]);
+    sift_down(heap, heap->position[last.item]);
 }
 
 size_t bk_heap_pop(bk_heap *heap)
 {
-    size_t top = heap->items[0];
+    size_t top = heap->entries[0].item;
     bk_heap_remove(heap, top);
     return top;
 }

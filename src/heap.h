@@ -6,10 +6,17 @@
 
 #include <stddef.h>
 
+/* Keys sit beside their items in heap order, so a sift compares neighbouring memory
+ * instead of fetching each key from wherever its item is (a long chain's queues hold 1e5
+ * items). */
+typedef struct bk_heap_entry {
+    double key;
+    size_t item;
+} bk_heap_entry;
+
 typedef struct bk_heap {
-    size_t *items;    /* heap order */
-    size_t *position; /* per item: its index in items, or BK_HEAP_ABSENT */
-    double *key;      /* per item */
+    bk_heap_entry *entries; /* heap order */
+    size_t *position;       /* per item: its index in entries, or BK_HEAP_ABSENT */
     size_t count, capacity;
 } bk_heap;
 
@@ -31,8 +38,8 @@ static inline int bk_heap_contains(const bk_heap *heap, size_t item)
 }
 static inline int bk_heap_empty(const bk_heap *heap) { return heap->count == 0; }
 /* The item with the smallest key (ties: the smaller item) and that key; heap not empty. */
-static inline size_t bk_heap_top(const bk_heap *heap) { return heap->items[0]; }
-static inline double bk_heap_top_key(const bk_heap *heap) { return heap->key[heap->items[0]]; }
+static inline size_t bk_heap_top(const bk_heap *heap) { return heap->entries[0].item; }
+static inline double bk_heap_top_key(const bk_heap *heap) { return heap->entries[0].key; }
 /* Remove and return the top item. */
 size_t bk_heap_pop(bk_heap *heap);
 

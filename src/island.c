@@ -24,43 +24,43 @@ size_t bk_island_max_y(const bk_scene *scene, size_t len)
     return len * (2 + scene->max_block_state) + 2;
 }
 
+size_t bk_island_y_length(const bk_scene *scene, size_t start, size_t len)
+{
+    size_t n_y = 2;
+    for (size_t k = 0; k < len; ++k) {
+        size_t i = start + k < scene->n ? start + k : start + k - scene->n;
+        if (!bk_scene_stuck(scene, i) || scene->full_layout)
+            n_y += 2;
+        n_y += scene->model->blocks[i].law->n_state;
+    }
+    return n_y;
+}
+
 int bk_island_reserve(bk_island *island, size_t len)
 {
     if (len <= island->capacity)
         return 0;
     size_t max_y = bk_island_max_y(island->scene, len);
-    size_t *active = realloc(island->active, len * sizeof *active);
-    if (!active)
+    size_t R = island->scene->roots_per_block;
+    /* One block for every layout array: an island's step reads them together. */
+    size_t bytes = len * (2 * sizeof(size_t) + sizeof(double)) + max_y * sizeof(double) +
+                   R * len * sizeof(int);
+    char *block = malloc(bytes);
+    if (!block)
         return -1;
-    island->active = active;
-    double *mass = realloc(island->active_mass, len * sizeof *mass);
-    if (!mass)
-        return -1;
-    island->active_mass = mass;
-    size_t *stateful = realloc(island->stateful, len * sizeof *stateful);
-    if (!stateful)
-        return -1;
-    island->stateful = stateful;
-    double *id = realloc(island->differential_id, max_y * sizeof *id);
-    if (!id)
-        return -1;
-    island->differential_id = id;
-    int *direction = realloc(island->root_direction,
-                             island->scene->roots_per_block * len * sizeof *direction);
-    if (!direction)
-        return -1;
-    island->root_direction = direction;
+    free(island->active);
+    island->active = (size_t *)(void *)block;
+    island->stateful = island->active + len;
+    island->active_mass = (double *)(void *)(island->stateful + len);
+    island->differential_id = island->active_mass + len;
+    island->root_direction = (int *)(void *)(island->differential_id + max_y);
     island->capacity = len;
     return 0;
 }
 
 void bk_island_free(bk_island *island)
 {
-    free(island->active);
-    free(island->active_mass);
-    free(island->stateful);
-    free(island->differential_id);
-    free(island->root_direction);
+    free(island->active); /* the block holding every layout array */
     island->active = island->stateful = NULL;
     island->active_mass = island->differential_id = NULL;
     island->root_direction = NULL;

@@ -2,7 +2,9 @@
 #include "bksim/model.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 bk_model *bk_model_create(size_t n_blocks)
 {
@@ -11,7 +13,12 @@ bk_model *bk_model_create(size_t n_blocks)
     bk_model *model = calloc(1, sizeof *model);
     if (!model)
         return NULL;
-    model->blocks = calloc(n_blocks, sizeof *model->blocks);
+    size_t bytes = n_blocks * sizeof *model->blocks;
+    model->blocks = n_blocks <= SIZE_MAX / sizeof *model->blocks
+                        ? aligned_alloc(_Alignof(bk_block), bytes)
+                        : NULL;
+    if (model->blocks)
+        memset(model->blocks, 0, bytes);
     if (!model->blocks) {
         free(model);
         return NULL;

@@ -55,6 +55,7 @@ typedef struct run_ctx {
     void **solvers;
     size_t n_solvers, solvers_capacity;
     void **idle;
+    size_t *idle_len;        /* the problem size each idle instance last served */
     size_t n_idle;
     /* Quiet stuck blocks by failure time (closed form, no integrator). */
     bk_heap quiet;

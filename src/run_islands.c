@@ -45,8 +45,6 @@ void bk_run_islands_free(run_ctx *ctx)
         run_island *isl = ctx->islands[id];
         bk_island_free(&isl->island);
         free(isl->y);
-        free(isl->y_probe);
-        free(isl->atol);
         free(isl->found);
         free(isl);
     }
@@ -54,6 +52,7 @@ void bk_run_islands_free(run_ctx *ctx)
         ctx->backend->destroy(ctx->solvers[k]);
     free(ctx->solvers);
     free(ctx->idle);
+    free(ctx->idle_len);
     free(ctx->islands);
     free(ctx->free_ids);
     free(ctx->batch);
@@ -80,11 +79,26 @@ static double island_key(const run_island *isl)
     return isl->pending ? isl->t_event : isl->t_reached;
 }
 
-/* A back-end instance: an idle one, else a new one (kept for its counters). */
-static int take_solver(run_ctx *ctx, void **solver)
+/* Idle instances searched for one that last served a problem of the same size: a back-end
+ * reuses its objects when the size repeats (allocating anew at every restart dominated on
+ * long chains). */
+#define IDLE_MATCH_SPAN 32
+
+/* A back-end instance for a problem of n_y unknowns: an idle one, else a new one (kept for
+ * its counters). */
+static int take_solver(run_ctx *ctx, size_t n_y, void **solver)
 {
     if (ctx->n_idle > 0) {
-        *solver = ctx->idle[--ctx->n_idle];
+        size_t pick = ctx->n_idle - 1;
+        for (size_t k = 0; k < IDLE_MATCH_SPAN && k < ctx->n_idle; ++k)
+            if (ctx->idle_len[ctx->n_idle - 1 - k] == n_y) {
+                pick = ctx->n_idle - 1 - k;
+                break;
+            }
+        *solver = ctx->idle[pick];
+        ctx->idle[pick] = ctx->idle[ctx->n_idle - 1];
+        ctx->idle_len[pick] = ctx->idle_len[ctx->n_idle - 1];
+        ctx->n_idle--;
         return BK_OK;
     }
     if (ctx->n_solvers == ctx->solvers_capacity) {
@@ -97,6 +111,10 @@ static int take_solver(run_ctx *ctx, void **solver)
         if (!idle)
             return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for solver instances");
         ctx->idle = idle;
+        size_t *idle_len = realloc(ctx->idle_len, cap * sizeof *idle_len);
+        if (!idle_len)
+            return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for solver instances");
+        ctx->idle_len = idle_len;
         ctx->solvers_capacity = cap;
     }
     int rc = ctx->backend->create(solver, &ctx->options, ctx->err);
@@ -107,7 +125,7 @@ static int take_solver(run_ctx *ctx, void **solver)
 }
 
 /* A free island id with its arrays (kept from an earlier island when there is one). */
-static int new_island(run_ctx *ctx, size_t *id)
+static int new_island(run_ctx *ctx, size_t n_y, size_t *id)
 {
     if (ctx->n_free > 0) {
         *id = ctx->free_ids[--ctx->n_free];
@@ -134,7 +152,7 @@ static int new_island(run_ctx *ctx, size_t *id)
         isl->island.id = *id;
     }
     run_island *isl = ctx->islands[*id];
-    int rc = take_solver(ctx, &isl->solver);
+    int rc = take_solver(ctx, n_y, &isl->solver);
     if (rc != BK_OK) {
         ctx->free_ids[ctx->n_free++] = *id;
         return rc;
@@ -148,6 +166,7 @@ static void release_island(run_ctx *ctx, size_t id)
 {
     run_island *isl = ctx->islands[id];
     bk_heap_remove(&ctx->island_queue, id);
+    ctx->idle_len[ctx->n_idle] = isl->island.n_y;
     ctx->idle[ctx->n_idle++] = isl->solver;
     isl->solver = NULL;
     isl->live = 0;
@@ -163,16 +182,13 @@ static int reserve_vectors(run_ctx *ctx, run_island *isl, size_t len)
     if (bk_island_reserve(&isl->island, len) != 0)
         return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for an island of %zu blocks", len);
     if (n_y > isl->capacity_y) {
-        double *y = realloc(isl->y, n_y * sizeof *y);
-        double *probe = y ? realloc(isl->y_probe, n_y * sizeof *probe) : NULL;
-        double *atol = probe ? realloc(isl->atol, n_y * sizeof *atol) : NULL;
-        if (y)
-            isl->y = y;
-        if (probe)
-            isl->y_probe = probe;
-        if (!atol)
+        /* One block: the island's vectors are touched together at every step. */
+        double *block = realloc(isl->y, 3 * n_y * sizeof *block);
+        if (!block)
             return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for an island of %zu blocks", len);
-        isl->atol = atol;
+        isl->y = block;
+        isl->y_probe = block + n_y;
+        isl->atol = block + 2 * n_y;
         isl->capacity_y = n_y;
     }
     if (n_roots > isl->capacity_roots) {
@@ -415,12 +431,15 @@ static int dissolve(run_ctx *ctx, size_t id, double t, int taken)
 static int found_island(run_ctx *ctx, long lo, long hi, double t)
 {
     size_t id = BK_NO_ISLAND;
-    int rc = new_island(ctx, &id);
+    int rc = new_island(ctx, bk_island_y_length(&ctx->scene, wrap(ctx, lo), (size_t)(hi - lo + 1)), &id);
     if (rc != BK_OK)
         return rc;
     bk_island *island = &ctx->islands[id]->island;
     island->start = wrap(ctx, lo);
     island->len = (size_t)(hi - lo + 1);
+    if (island->len > ctx->scene.n)
+        return BK_FAIL(ctx->err, BK_ERR_INTERNAL, "an island of %zu blocks on a chain of %zu at t = %.17g s",
+                       island->len, ctx->scene.n, t);
     return start_island(ctx, id, t);
 }
 
@@ -809,13 +828,33 @@ int bk_run_quiet_failures(run_ctx *ctx, double t)
     ctx->stats->stuck_jumps++;
     if (count > 0 && ctx->event_rows)
         ctx->t_row_due = t;
-    for (size_t k = 0; k < count; ++k) {
-        size_t i = ctx->batch[k];
-        if (scene->island_of[i] != BK_NO_ISLAND)
-            continue; /* joined the island of a block that failed before it */
-        int rc = repartition(ctx, (long)i, (long)i, t, BK_NO_ISLAND);
-        if (rc != BK_OK)
-            return rc;
+    /* One repartition per run of neighbouring failures, so that every range rebuilt ends
+     * on blocks that did not fail.  On a ring a run may pass from block n - 1 to block 0:
+     * the scan then starts where that run does, its first blocks counted below 0. */
+    long n = (long)scene->n;
+    size_t first = 0;
+    if (periodic(ctx) && count > 0 && (long)count < n && ctx->batch[0] == 0 &&
+        (long)ctx->batch[count - 1] == n - 1) {
+        first = count - 1;
+        while (first > 0 && ctx->batch[first - 1] + 1 == ctx->batch[first])
+            --first;
     }
+    long lo = 0, prev = 0;
+    for (size_t m = 0; m < count; ++m) {
+        size_t idx = (first + m) % count;
+        long j = (long)ctx->batch[idx] - (first > 0 && idx >= first ? n : 0);
+        if (m > 0 && j == prev + 1) {
+            prev = j;
+            continue;
+        }
+        if (m > 0) {
+            int rc = repartition(ctx, lo, prev, t, BK_NO_ISLAND);
+            if (rc != BK_OK)
+                return rc;
+        }
+        lo = prev = j;
+    }
+    if (count > 0)
+        return repartition(ctx, lo, prev, t, BK_NO_ISLAND);
     return BK_OK;
 }

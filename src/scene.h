@@ -125,6 +125,8 @@ static inline size_t bk_island_n_roots(const bk_island *island)
 {
     return island->scene->roots_per_block * island->len;
 }
+/* The length of y an island over blocks start .. start + len - 1 gets for their current modes. */
+size_t bk_island_y_length(const bk_scene *scene, size_t start, size_t len);
 /* Longest y an island of len blocks can need. */
 size_t bk_island_max_y(const bk_scene *scene, size_t len);
 

@@ -635,6 +635,45 @@ static void test_long_chain_clusters(void **state)
     }
 }
 
+/* A uniform chain started relaxed slides as one block (its couplings never stretch), so
+ * symmetric inputs must give symmetric outputs: every instant holds a transition of every
+ * block, at the single block's closed-form times (the same dynamics: coupling plays no
+ * part), on free and periodic chains of several lengths, as the integrators give too. */
+static void test_uniform_chain_slides_as_one(void **state)
+{
+    (void)state;
+    const size_t lengths[] = {2, 5, 16, 33};
+    const bk_boundary boundaries[] = {BK_BOUNDARY_FREE, BK_BOUNDARY_PERIODIC};
+    exact_params p = {1.0, 1e4, 9.81, 0.6, 0.5, 1e-3, 0};
+    exact_solution ex;
+    assert_int_equal(exact_solve(&p, 3.0, &ex), 0);
+    for (size_t b = 0; b < 2; ++b)
+        for (size_t l = 0; l < sizeof lengths / sizeof *lengths; ++l) {
+            scene_spec spec = paper_case(0.5, BK_SPRING_LINEAR, 1e-10, "exact");
+            spec.n = lengths[l];
+            spec.coupling = 2e4;
+            spec.boundary = boundaries[b];
+            spec.t_end = 3.0;
+            recorder r = {0};
+            bk_error err = {0};
+            if (run_spec(&spec, &r, NULL, &err) != BK_OK)
+                fail_msg("%s", err.message);
+            assert_int_equal(r.n_transitions, spec.n * ex.n_events);
+            double worst = 0.0;
+            for (size_t e = 0; e < ex.n_events; ++e)
+                for (size_t i = 0; i < spec.n; ++i) {
+                    const bk_transition *t = &r.transitions[e * spec.n + i];
+                    assert_int_equal(t->block, (int32_t)i); /* one instant, in block order */
+                    assert_int_equal(t->to, ex.events[e].to);
+                    assert_true(t->t == r.transitions[e * spec.n].t && t->x == r.transitions[e * spec.n].x);
+                    worst = fmax(worst, relative(t->t, ex.events[e].t));
+                }
+            assert_true(worst <= 1e-13);
+            recorder_free(&r);
+        }
+    exact_free(&ex);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -653,6 +692,7 @@ int main(void)
         cmocka_unit_test(test_free_mode),
         cmocka_unit_test(test_chains_against_cvode),
         cmocka_unit_test(test_long_chain_clusters),
+        cmocka_unit_test(test_uniform_chain_slides_as_one),
     };
     return cmocka_run_group_tests_name("exact", tests, NULL, NULL);
 }

@@ -36,19 +36,26 @@
  * relative, including case C's grazing stops that no tolerance-driven integrator resolves)
  * and, with a few dozen root evaluations per slip, the fastest method for Coulomb scenes.
  *
- * Why clusters.  Stuck blocks are fixed, so on a long chain the slipping blocks form many
- * independent short stretches even when hundreds slip at once.  Decomposing the whole p x p
- * matrix cost O(p^3) per restart and every root probe O(p^2), which made the stepper slower
- * than CVODE beyond a few dozen blocks.  Per cluster the decomposition costs sum p_i^3 and
- * a probe sum p_i^2 + O(p); the eigenvectors are exactly those of the block-diagonal matrix,
- * so nothing is approximated.  A restart changes one or two clusters and the others keep
- * their matrices bit for bit (and on a uniform chain, equal stretches share one matrix), so
- * decompositions are cached by the matrix's exact bytes: a hit returns what GSL would
- * compute, which keeps runs and restarts bit-identical.  K, P and Q come from the problem's
- * exact Jacobian when it has one (O(p) entries, checked against the right-hand side by one
- * combined probe) instead of one right-hand-side probe per component, which is O(p^2).
- * What stays superlinear is one long stretch slipping together (a uniform chain's
- * synchronous slide): a cluster of p pairs costs p^3 per restart and p^2 per probe. */
+ * Why clusters.  Stuck blocks are fixed, so the slipping blocks an island integrates form
+ * independent short stretches even when many slip at once.  Decomposing the whole p x p
+ * matrix would cost O(p^3) per restart and every root probe O(p^2); per cluster the
+ * decomposition costs sum p_i^2 and a probe sum p_i^2 + O(p), and the eigenvectors are
+ * exactly those of the block-diagonal matrix, so nothing is approximated.  A chain stretch's
+ * S is tridiagonal, and LAPACK's dstevr (relatively robust representations) diagonalises it
+ * in O(p^2); only a ring slipping all round (cyclic S) goes through GSL's dense symmv, p^3.
+ * K, P and Q come from the problem's exact Jacobian when it has one (O(p) entries, checked
+ * against the right-hand side by one combined probe) instead of one right-hand-side probe
+ * per component, which is O(p^2).
+ *
+ * Why uniform clusters are special.  Blocks of equal mass, equal velocity and equal
+ * acceleration whose stiffness rows sum alike (a uniform chain slipping together, its
+ * couplings exactly balanced) move as one: their motion is the single oscillator of that
+ * row sum.  The eigenvectors of such a cluster are exact only up to rounding, and summing
+ * the modes back would give each block a slightly different motion, so a uniform chain
+ * that physically slides as one would break into sub-events (seen: 3,393 transitions where
+ * the integrators give 41 synchronous slips of 16 blocks).  So a uniform cluster is solved
+ * as that one oscillator and every member gets the same numbers: symmetric inputs give
+ * symmetric outputs, and the cost is O(p) however long the cluster. */
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
@@ -60,6 +67,7 @@
 #include <gsl/gsl_matrix.h>
 #include <gsl/gsl_roots.h>
 #include <gsl/gsl_vector.h>
+#include <lapacke.h>
 
 #include "bksim/solver.h"
 
@@ -73,25 +81,12 @@
 #define BRENT_MAX_ITER 200
 #define MAX_HALVINGS 16
 #define USE_INTEGRATOR "; use method = auto (it picks an integrator for such scenes), gsl_rk8pd or cvode_bdf"
-/* Decomposition cache: direct-mapped slots, and a bound on the doubles all entries hold
- * (16 MiB); past it the cache starts over.  A chain's distinct cluster matrices number a
- * few per cluster length, far below either bound. */
-#define CACHE_BITS 12
-#define CACHE_SLOTS ((size_t)1 << CACHE_BITS)
-#define CACHE_BUDGET ((size_t)1 << 21)
-
 /* Stiffness coupling K[row][col] (s^-2) between pairs, one Jacobian entry or probe column;
  * entries for one (row, col) add up. */
 typedef struct coupling {
     size_t row, col;
     double value;
 } coupling;
-
-typedef struct cached_modes {
-    uint64_t hash;
-    size_t size;                /* pairs; 0 = empty slot */
-    double *data;               /* S (size^2, the key), then w^2 (size), then U (size^2) */
-} cached_modes;
 
 /* A problem the Jacobian shows the stepper cannot solve (first offending entry). */
 enum { JACOBIAN_OK, JACOBIAN_NOMEM, JACOBIAN_RANGE, JACOBIAN_VELOCITY, JACOBIAN_QUADRATURE };
@@ -115,6 +110,7 @@ typedef struct exact_backend {
     double *c, *g, *d;          /* p: modal initial velocity, forcing, forcing rate */
     double *eta, *deta, *ieta, *idv; /* p: eta, eta' - c, their integrals */
     double *accel0, *accel_rate;/* p: accelerations at t0 and their time rate */
+    double *row_sum, *row_scale;/* p: sum and largest magnitude of each row of K */
     double *P, *Q;              /* m*p: quadrature rates' position and velocity coefficients */
     double *P_modal, *Q_modal;  /* m*p: the same in modal coordinates */
     double *qdot0, *q_rate;     /* m: quadrature rates at t0 and their time rate */
@@ -124,6 +120,7 @@ typedef struct exact_backend {
     size_t *indices;
     size_t indices_cap;
     size_t *members, *first, *offset, *cluster_of, *local, *parent; /* p (+1) each */
+    size_t *uniform;            /* per cluster: it moves as one (see the top of the file) */
     size_t n_clusters;
     coupling *couplings;        /* K's entries */
     size_t n_couplings, couplings_cap;
@@ -134,9 +131,6 @@ typedef struct exact_backend {
     gsl_eigen_symmv_workspace *eigen;
     int jacobian_status;
     size_t bad_row, bad_col;
-
-    cached_modes *cache;        /* CACHE_SLOTS */
-    size_t cache_doubles;
 
     /* Root functions. */
     size_t roots_cap;
@@ -202,6 +196,14 @@ static void exact_state(exact_backend *eb, double t, double *y)
         size_t first = eb->first[cl], size = eb->first[cl + 1] - first;
         const double *T = &eb->T[eb->offset[cl]];
         const double *eta = &eb->eta[first], *deta = &eb->deta[first];
+        if (eb->uniform[cl]) {
+            for (size_t r = 0; r < size; ++r) {
+                size_t i = eb->members[first + r];
+                y[2 * i] = eb->y0[2 * i] + eta[0];
+                y[2 * i + 1] = eb->y0[2 * i + 1] + deta[0];
+            }
+            continue;
+        }
         for (size_t r = 0; r < size; ++r) {
             const double *Tr = &T[r * size];
             double u = 0.0, dv = 0.0;
@@ -227,7 +229,7 @@ static void exact_state(exact_backend *eb, double t, double *y)
 
 static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roots, bk_error *err)
 {
-    size_t need = 7 * n + 12 * p + 4 * m * p + 2 * m + 1;
+    size_t need = 7 * n + 14 * p + 4 * m * p + 2 * m + 1;
     if (need > eb->arena_cap) {
         double *grown = malloc(need * sizeof *grown);
         if (!grown)
@@ -256,6 +258,8 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->idv = a, a += p;
     eb->accel0 = a, a += p;
     eb->accel_rate = a, a += p;
+    eb->row_sum = a, a += p;
+    eb->row_scale = a, a += p;
     eb->P = a, a += m * p;
     eb->Q = a, a += m * p;
     eb->P_modal = a, a += m * p;
@@ -263,7 +267,7 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->qdot0 = a, a += m;
     eb->q_rate = a;
 
-    size_t need_indices = 6 * (p + 1);
+    size_t need_indices = 7 * (p + 1);
     if (need_indices > eb->indices_cap) {
         size_t *grown = malloc(need_indices * sizeof *grown);
         if (!grown)
@@ -278,6 +282,7 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->offset = ix, ix += p + 1;
     eb->cluster_of = ix, ix += p + 1;
     eb->local = ix, ix += p + 1;
+    eb->uniform = ix, ix += p + 1;
     eb->parent = ix;
 
     if (n_roots > eb->roots_cap) {
@@ -305,7 +310,7 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
 /* Room for the clusters' S and T (`total` doubles each) and one work copy of `largest`^2. */
 static int reserve_matrices(exact_backend *eb, size_t total, size_t largest, bk_error *err)
 {
-    size_t need = 2 * total + largest * largest + 1;
+    size_t need = 2 * total + largest * largest + 3 * largest + 1;
     if (need > eb->matrices_cap) {
         double *grown = malloc(need * sizeof *grown);
         if (!grown)
@@ -335,15 +340,6 @@ static int add_coupling(exact_backend *eb, size_t row, size_t col, double value)
     return 0;
 }
 
-static void cache_clear(exact_backend *eb)
-{
-    for (size_t s = 0; s < CACHE_SLOTS; ++s) {
-        free(eb->cache[s].data);
-        eb->cache[s] = (cached_modes){0};
-    }
-    eb->cache_doubles = 0;
-}
-
 static int create(void **mem, const bk_solver_options *options, bk_error *err)
 {
     exact_backend *eb = calloc(1, sizeof *eb);
@@ -351,11 +347,7 @@ static int create(void **mem, const bk_solver_options *options, bk_error *err)
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory");
     eb->options = *options;
     eb->brent = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
-    eb->cache = calloc(CACHE_SLOTS, sizeof *eb->cache);
-    if (!eb->brent || !eb->cache) {
-        if (eb->brent)
-            gsl_root_fsolver_free(eb->brent);
-        free(eb->cache);
+    if (!eb->brent) {
         free(eb);
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for the root finder");
     }
@@ -371,8 +363,6 @@ static void destroy(void *mem)
     if (eb->eigen)
         gsl_eigen_symmv_free(eb->eigen);
     gsl_root_fsolver_free(eb->brent);
-    cache_clear(eb);
-    free(eb->cache);
     free(eb->arena);
     free(eb->indices);
     free(eb->couplings);
@@ -640,6 +630,27 @@ static size_t find_set(size_t *parent, size_t i)
     return i;
 }
 
+/* Cluster k moves as one: two or more pairs of equal mass, equal starting velocity, equal
+ * acceleration and equal rate of it, whose rows of K sum alike (to rounding: the ends of a
+ * free chain sum their couplings in another order). */
+static int uniform_cluster(const exact_backend *eb, size_t k)
+{
+    size_t first = eb->first[k], size = eb->first[k + 1] - first;
+    if (size < 2)
+        return 0;
+    size_t a = eb->members[first];
+    for (size_t r = 1; r < size; ++r) {
+        size_t i = eb->members[first + r];
+        if (eb->sqrt_mass[i] != eb->sqrt_mass[a] || eb->y0[2 * i + 1] != eb->y0[2 * a + 1] ||
+            eb->accel0[i] != eb->accel0[a] || eb->accel_rate[i] != eb->accel_rate[a])
+            return 0;
+        double scale = fmax(eb->row_scale[i], eb->row_scale[a]);
+        if (fabs(eb->row_sum[i] - eb->row_sum[a]) > 16.0 * DBL_EPSILON * scale)
+            return 0;
+    }
+    return 1;
+}
+
 /* Clusters: connected components of K's couplings (a set's root is its smallest pair), in
  * the order of their first pairs; each cluster's S assembled densely. */
 static int split_clusters(exact_backend *eb, bk_error *err)
@@ -666,18 +677,14 @@ static int split_clusters(exact_backend *eb, bk_error *err)
         eb->first[eb->cluster_of[i]]++;
     }
     eb->n_clusters = count;
-    /* Sizes into each cluster's first mode, and matrix offsets. */
-    size_t placed = 0, total = 0, largest = 0;
+    /* Sizes into each cluster's first mode. */
+    size_t placed = 0;
     for (size_t k = 0; k < count; ++k) {
         size_t size = eb->first[k];
         eb->first[k] = placed;
-        eb->offset[k] = total;
         placed += size;
-        total += size * size;
-        largest = size > largest ? size : largest;
     }
     eb->first[count] = placed;
-    eb->offset[count] = total;
     for (size_t k = 0; k < count; ++k)
         parent[k] = eb->first[k]; /* the next free member slot */
     for (size_t i = 0; i < p; ++i) {
@@ -685,6 +692,25 @@ static int split_clusters(exact_backend *eb, bk_error *err)
         eb->local[i] = parent[k] - eb->first[k];
         eb->members[parent[k]++] = i;
     }
+    for (size_t i = 0; i < p; ++i)
+        eb->row_sum[i] = eb->row_scale[i] = 0.0;
+    for (size_t e = 0; e < eb->n_couplings; ++e) {
+        const coupling *cp = &eb->couplings[e];
+        eb->row_sum[cp->row] += cp->value;
+        eb->row_scale[cp->row] = fmax(eb->row_scale[cp->row], fabs(cp->value));
+    }
+    /* Matrix offsets: a uniform cluster needs none. */
+    size_t total = 0, largest = 0;
+    for (size_t k = 0; k < count; ++k) {
+        size_t size = eb->first[k + 1] - eb->first[k];
+        eb->uniform[k] = (size_t)uniform_cluster(eb, k);
+        eb->offset[k] = total;
+        if (eb->uniform[k])
+            continue;
+        total += size * size;
+        largest = size > largest ? size : largest;
+    }
+    eb->offset[count] = total;
     int rc = reserve_matrices(eb, total, largest, err);
     if (rc != BK_OK)
         return rc;
@@ -692,25 +718,25 @@ static int split_clusters(exact_backend *eb, bk_error *err)
     for (size_t e = 0; e < eb->n_couplings; ++e) {
         const coupling *cp = &eb->couplings[e];
         size_t k = eb->cluster_of[cp->row], size = eb->first[k + 1] - eb->first[k];
-        eb->S[eb->offset[k] + eb->local[cp->row] * size + eb->local[cp->col]] += cp->value;
+        if (!eb->uniform[k])
+            eb->S[eb->offset[k] + eb->local[cp->row] * size + eb->local[cp->col]] += cp->value;
     }
     return BK_OK;
 }
 
-static uint64_t hash_matrix(const double *S, size_t count)
+/* Whether the size x size S has entries only on its three middle diagonals. */
+static int tridiagonal(const double *S, size_t size)
 {
-    uint64_t hash = 14695981039346656037u ^ count;
-    for (size_t k = 0; k < count; ++k) {
-        uint64_t bits;
-        memcpy(&bits, &S[k], sizeof bits);
-        hash = (hash ^ bits) * 1099511628211u;
-        hash ^= hash >> 31;
-    }
-    return hash;
+    for (size_t r = 0; r < size; ++r)
+        for (size_t q = 0; q < size; ++q)
+            if ((r > q + 1 || q > r + 1) && S[r * size + q] != 0.0)
+                return 0;
+    return 1;
 }
 
-/* Eigenvalues and eigenvectors of the symmetric size x size S (kept intact), from the cache
- * when S was seen before. */
+/* Eigenvalues and eigenvectors (columns of U) of the symmetric size x size S (kept intact):
+ * LAPACK's dstevr when S is tridiagonal (a stretch of the chain: O(size^2)), else GSL's
+ * dense symmv (a ring slipping all round). */
 static int eigen_decompose(exact_backend *eb, const double *S, size_t size, double *lambda,
                            double *U, bk_error *err)
 {
@@ -720,11 +746,22 @@ static int eigen_decompose(exact_backend *eb, const double *S, size_t size, doub
         U[0] = 1.0;
         return BK_OK;
     }
-    uint64_t hash = hash_matrix(S, count);
-    cached_modes *slot = &eb->cache[hash >> (64 - CACHE_BITS)];
-    if (slot->size == size && slot->hash == hash && memcmp(slot->data, S, count * sizeof *S) == 0) {
-        memcpy(lambda, slot->data + count, size * sizeof *lambda);
-        memcpy(U, slot->data + count + size, count * sizeof *U);
+    if (tridiagonal(S, size)) {
+        /* d and e in the work copy, the support indices after them. */
+        double *d = eb->work, *e = eb->work + size;
+        for (size_t r = 0; r < size; ++r) {
+            d[r] = S[r * size + r];
+            if (r + 1 < size)
+                e[r] = S[r * size + r + 1];
+        }
+        lapack_int found = 0, n = (lapack_int)size;
+        lapack_int *support = (lapack_int *)(void *)(eb->work + 2 * size);
+        lapack_int info = LAPACKE_dstevr(LAPACK_ROW_MAJOR, 'V', 'A', n, d, e, 0.0, 0.0, 0, 0, 0.0,
+                                         &found, lambda, U, n, support);
+        if (info != 0 || found != n)
+            return BK_FAIL(err, BK_ERR_SOLVER,
+                           "exact stepper: tridiagonal eigen-decomposition of %zu modes failed "
+                           "(LAPACK dstevr info %d, %d found)", size, (int)info, (int)found);
         return BK_OK;
     }
     /* GSL documents the workspace for one matrix size: keep it exactly this one. */
@@ -743,33 +780,53 @@ static int eigen_decompose(exact_backend *eb, const double *S, size_t size, doub
     if (rc != GSL_SUCCESS)
         return BK_FAIL(err, BK_ERR_SOLVER, "exact stepper: eigen-decomposition failed: %s",
                        gsl_strerror(rc));
-    /* Remember it; without memory it is merely not remembered. */
-    size_t entry = 2 * count + size;
-    if (entry > CACHE_BUDGET / 8)
-        return BK_OK;
-    if (eb->cache_doubles + entry > CACHE_BUDGET)
-        cache_clear(eb);
-    double *data = malloc(entry * sizeof *data);
-    if (!data)
-        return BK_OK;
-    if (slot->data) {
-        eb->cache_doubles -= 2 * slot->size * slot->size + slot->size;
-        free(slot->data);
-    }
-    memcpy(data, S, count * sizeof *S);
-    memcpy(data + count, lambda, size * sizeof *lambda);
-    memcpy(data + count + size, U, count * sizeof *U);
-    slot->hash = hash;
-    slot->size = size;
-    slot->data = data;
-    eb->cache_doubles += entry;
     return BK_OK;
 }
 
 /* Cluster k: symmetrise its S, diagonalise; its modes' frequencies, initial velocities and
  * forcing, and T = M^(-1/2) U. */
+/* A uniform cluster: one oscillator in the pairs' own units (u = eta for every member), its
+ * frequency the rows' common sum; the other modes are idle at that frequency (so that the
+ * sampling step stays what the cluster needs). */
+static int uniform_modes(exact_backend *eb, size_t k, bk_error *err)
+{
+    size_t first = eb->first[k], size = eb->first[k + 1] - first;
+    const size_t *members = &eb->members[first];
+    size_t a = members[0];
+    double l = eb->row_sum[a];
+    if (l < -ZERO_MODE * eb->row_scale[a])
+        return BK_FAIL(err, BK_ERR_CONFIG,
+                       "method exact: mode %zu is unstable (negative stiffness eigenvalue %.6g "
+                       "s^-2); only oscillating or free modes are solved exactly" USE_INTEGRATOR,
+                       first, l);
+    if (l <= ZERO_MODE * eb->row_scale[a])
+        l = 0.0;
+    for (size_t q = 0; q < size; ++q) {
+        eb->omega2[first + q] = l;
+        eb->omega[first + q] = sqrt(l);
+        eb->c[first + q] = q == 0 ? eb->y0[2 * a + 1] : 0.0;
+        eb->g[first + q] = q == 0 ? eb->accel0[a] : 0.0;
+        eb->d[first + q] = q == 0 ? eb->accel_rate[a] : 0.0;
+    }
+    for (size_t j = 0; j < eb->m; ++j) {
+        const double *Pj = &eb->P[j * eb->p], *Qj = &eb->Q[j * eb->p];
+        double pq = 0.0, qq = 0.0;
+        for (size_t r = 0; r < size; ++r) {
+            pq += Pj[members[r]];
+            qq += Qj[members[r]];
+        }
+        for (size_t q = 0; q < size; ++q) {
+            eb->P_modal[j * eb->p + first + q] = q == 0 ? pq : 0.0;
+            eb->Q_modal[j * eb->p + first + q] = q == 0 ? qq : 0.0;
+        }
+    }
+    return BK_OK;
+}
+
 static int cluster_modes(exact_backend *eb, size_t k, bk_error *err)
 {
+    if (eb->uniform[k])
+        return uniform_modes(eb, k, err);
     size_t first = eb->first[k], size = eb->first[k + 1] - first;
     const size_t *members = &eb->members[first];
     double *S = &eb->S[eb->offset[k]], *T = &eb->T[eb->offset[k]];

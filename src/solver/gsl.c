@@ -72,7 +72,9 @@ typedef struct gsl_backend {
     gsl_odeiv2_system sys;
     gsl_odeiv2_driver *driver;  /* owns step, control and evolve */
     gsl_odeiv2_step *probe;     /* second stepper for DENSE_RESTEP */
+    size_t driver_n;            /* the size driver and probe were made for */
     size_t n, capacity;         /* state size; allocated length of the arrays below */
+    double *arena;              /* every array below but active and found */
     double *y_lo, *f_lo, *y_hi, *f_hi, *y_root, *y_probe, *atol, *work, *work2, *yerr;
     size_t root_capacity;
     double *g_scan, *g_hi, *g_probe, *g_root;
@@ -350,52 +352,47 @@ static void free_steppers(gsl_backend *b)
 
 static void free_arrays(gsl_backend *b)
 {
-    double **owned[] = {&b->y_lo, &b->f_lo, &b->y_hi, &b->f_hi, &b->y_root, &b->y_probe,
-                        &b->atol, &b->work, &b->work2, &b->yerr, &b->g_scan, &b->g_hi,
-                        &b->g_probe, &b->g_root};
-    const size_t n_owned = sizeof(owned) / sizeof(owned[0]);
-    for (size_t k = 0; k < n_owned; ++k) {
-        double **slot = owned[k];
-        free(*slot);
-        *slot = NULL;
-    }
+    free(b->arena);
     free(b->active);
-    free(b->found);
+    b->arena = NULL;
     b->active = b->found = NULL;
     b->capacity = b->root_capacity = 0;
 }
 
+/* Every array of the instance in one block, laid out in the order a step visits them: a long
+ * chain runs thousands of islands in turn, each with its own instance, and scattered small
+ * blocks cost a cache miss each at every turn. */
 static int reserve(gsl_backend *b, size_t n, size_t m)
 {
-    if (n > b->capacity) {
-        double **arrays[] = {&b->y_lo, &b->f_lo, &b->y_hi, &b->f_hi, &b->y_root, &b->y_probe,
-                             &b->atol, &b->work, &b->work2, &b->yerr};
-        for (size_t k = 0; k < sizeof arrays / sizeof *arrays; ++k) {
-            double *grown = realloc(*arrays[k], n * sizeof *grown);
-            if (!grown)
-                return -1;
-            *arrays[k] = grown;
-        }
-        b->capacity = n;
+    if (n <= b->capacity && m <= b->root_capacity)
+        return 0;
+    size_t cap_n = n > b->capacity ? n : b->capacity, cap_m = m > b->root_capacity ? m : b->root_capacity;
+    double *arena = malloc((10 * cap_n + 4 * cap_m + 1) * sizeof *arena);
+    int *flags = malloc((2 * cap_m + 1) * sizeof *flags);
+    if (!arena || !flags) {
+        free(arena);
+        free(flags);
+        return -1;
     }
-    if (m > b->root_capacity) {
-        double **arrays[] = {&b->g_scan, &b->g_hi, &b->g_probe, &b->g_root};
-        for (size_t k = 0; k < sizeof arrays / sizeof *arrays; ++k) {
-            double *grown = realloc(*arrays[k], m * sizeof *grown);
-            if (!grown)
-                return -1;
-            *arrays[k] = grown;
-        }
-        int *active = realloc(b->active, m * sizeof *active);
-        if (!active)
-            return -1;
-        b->active = active;
-        int *found = realloc(b->found, m * sizeof *found);
-        if (!found)
-            return -1;
-        b->found = found;
-        b->root_capacity = m;
-    }
+    double **arrays[] = {&b->y_lo, &b->f_lo, &b->y_hi, &b->f_hi, &b->y_root, &b->y_probe,
+                         &b->atol, &b->work, &b->work2, &b->yerr};
+    double **roots[] = {&b->g_scan, &b->g_hi, &b->g_probe, &b->g_root};
+    double *next = arena;
+    for (size_t k = 0; k < sizeof arrays / sizeof *arrays; ++k, next += cap_n)
+        *arrays[k] = next;
+    for (size_t k = 0; k < sizeof roots / sizeof *roots; ++k, next += cap_m)
+        *roots[k] = next;
+    /* Nothing carries over: a start fills what it needs, and the driver points at work, so
+     * it is made anew. */
+    free_steppers(b);
+    b->driver_n = 0;
+    free(b->arena);
+    free(b->active);
+    b->arena = arena;
+    b->active = flags;
+    b->found = flags + cap_m;
+    b->capacity = cap_n;
+    b->root_capacity = cap_m;
     return 0;
 }
 
@@ -474,7 +471,6 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
         return BK_FAIL(err, BK_ERR_SOLVER, "GSL: empty problem");
     if (reserve(b, n, problem->n_roots) != 0)
         return BK_FAIL(err, BK_ERR_NOMEM, "GSL: cannot allocate a problem of size %zu", n);
-    free_steppers(b);
     b->n = n;
     b->sys = (gsl_odeiv2_system){rhs_adapter, b->variant->needs_jacobian ? jacobian : NULL, n, b};
     memcpy(b->atol, atol, n * sizeof *atol);
@@ -500,11 +496,25 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     for (size_t i = 0; i < n; ++i)
         b->work[i] = eps_abs > 0.0 ? atol[i] / eps_abs : 0.0;
     double factor = b->variant->tolerance_factor;
-    b->driver = gsl_odeiv2_driver_alloc_scaled_new(&b->sys, *b->variant->type,
-                                                   b->h > 0.0 ? b->h : 1.0, factor * eps_abs,
-                                                   factor * b->options.rtol, 1.0, 0.0, b->work);
-    if (b->variant->dense == DENSE_RESTEP)
-        b->probe = gsl_odeiv2_step_alloc(*b->variant->type, n);
+    double h_start = b->h > 0.0 ? b->h : 1.0;
+    if (b->driver && b->driver_n == n) {
+        /* Same size: reset what exists rather than allocate anew (an island restarts at
+         * every event; allocating there dominated on long chains).  Reset, the objects
+         * start exactly as new ones do. */
+        gsl_odeiv2_driver_reset(b->driver);
+        gsl_odeiv2_control_init(b->driver->c, factor * eps_abs, factor * b->options.rtol, 1.0, 0.0);
+        gsl_odeiv2_driver_reset_hstart(b->driver, h_start);
+        /* The probe re-steps from the step's start with its derivative given each time: it
+         * keeps nothing between uses, so it needs no reset. */
+    } else {
+        free_steppers(b);
+        b->driver = gsl_odeiv2_driver_alloc_scaled_new(&b->sys, *b->variant->type, h_start,
+                                                       factor * eps_abs, factor * b->options.rtol,
+                                                       1.0, 0.0, b->work);
+        if (b->variant->dense == DENSE_RESTEP)
+            b->probe = gsl_odeiv2_step_alloc(*b->variant->type, n);
+        b->driver_n = n;
+    }
     if (!b->driver || (b->variant->dense == DENSE_RESTEP && !b->probe)) {
         free_steppers(b);
         return BK_FAIL(err, BK_ERR_NOMEM, "GSL %s: cannot allocate the stepper (n = %zu)",
