@@ -15,9 +15,9 @@
  *               + dissipation), relative to the largest term (the driver work in a run
  *               that starts relaxed)
  *
- * Modes: the sweep (default), --scaling (CPU per transition against chain length),
- * --long-run (phase drift over 1e4 stick-slip cycles).  Output: TSV on stdout (or --out
- * FILE); `scripts/bench.sh` drives all three and plots.  Not part of CI (a --quick smoke
+ * Modes: the sweep (default) and --long-run (phase drift over 1e4 stick-slip cycles).
+ * Output: TSV on stdout (or --out FILE); `scripts/bench.sh` drives both, the CLI runs of
+ * scripts/bench_scaling.sh (cost and memory against chain length), and plots.  Not part of CI (a --quick smoke
  * run is). */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -217,64 +217,6 @@ static void row(FILE *out, const char *case_name, const char *method, double rto
     fflush(out);
 }
 
-/* A copy of config with [model] n_blocks = n (and one more line), for the scaling sweep. */
-static int cut_chain(const char *config, size_t n, const char *extra, char *path)
-{
-    snprintf(path, 64, "/tmp/bksim_scaling_XXXXXX");
-    int fd = mkstemp(path);
-    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
-    FILE *in = fopen(config, "r");
-    if (!f || !in) {
-        if (f)
-            fclose(f);
-        if (in)
-            fclose(in);
-        if (fd >= 0)
-            remove(path);
-        return -1;
-    }
-    char line[256];
-    while (fgets(line, sizeof line, in))
-        if (strncmp(line, "n_blocks", 8) != 0 && !(extra && strncmp(line, "x_init_random", 13) == 0))
-            fputs(line, f);
-    fprintf(f, "[model]\nn_blocks = %zu\n", n);
-    fclose(in);
-    fclose(f);
-    return 0;
-}
-
-/* CPU per transition against chain length: the 1000-block chain's config cut to N blocks
- * (heterogeneous: random initial offsets; 0.5 s), and the same chain uniform (every block
- * alike: it slides as a whole, the exact stepper's worst case; 2 s). */
-static void scaling(FILE *out, int quick)
-{
-    static const size_t sizes[] = {10, 30, 100, 300, 1000};
-    static const char *const methods[] = {"exact", "gsl_rk8pd", "cvode_adams", "arkode_dp45", "cvode_bdf", "ida"};
-    fprintf(out, "chain\tn_blocks\tmethod\tstatus\tcpu_s\trepeats\ttransitions\tcpu_per_transition_s\tsteps\n");
-    for (int uniform = 0; uniform < 2; ++uniform)
-        for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; ++k) {
-            if (quick && k > 0)
-                break;
-            for (size_t m = 0; m < sizeof methods / sizeof methods[0]; ++m) {
-                if (uniform && strcmp(methods[m], "exact") != 0 && strcmp(methods[m], "gsl_rk8pd") != 0)
-                    continue;
-                char path[64];
-                if (cut_chain("configs/chains/bk1000_coulomb.ini", sizes[k], uniform ? "" : NULL, path) != 0)
-                    continue;
-                /* A uniform chain first fails at 0.5886 s, as the single block. */
-                bench_case bc = {"chain", path, NULL, uniform ? 2.0 : 0.5, 1e-2, {NULL, 0}, {{NULL, 0}}};
-                int heavy = sizes[k] >= 1000 && (strcmp(methods[m], "ida") == 0 || uniform);
-                outcome o = run_case(&bc, methods[m], 1e-8, heavy || quick ? 1 : 3, 600.0);
-                fprintf(out, "%s\t%zu\t%s\t%s\t%.6g\t%d\t%zu\t%.6g\t%ld\n", uniform ? "uniform" : "random", sizes[k],
-                        methods[m], o.status == BK_OK ? "ok" : "failed", o.cpu, o.repeats, o.record.n_events,
-                        o.record.n_events ? o.cpu / (double)o.record.n_events : NAN, o.stats.steps);
-                fflush(out);
-                record_free(&o.record);
-                remove(path);
-            }
-        }
-}
-
 /* 1e4 stick-slip cycles of case B's block (2300 s, transition rows only): every back-end's
  * transition times against the exact stepper's, over the first and the last 100 cycles. */
 static void long_run(FILE *out, int quick)
@@ -378,16 +320,14 @@ static void sweep(FILE *out, int quick, int repeats, const char *only)
 
 int main(int argc, char **argv)
 {
-    int quick = 0, repeats = 3, mode = 0;
+    int quick = 0, repeats = 3, long_run_mode = 0;
     const char *only = NULL;
     FILE *out = stdout;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--quick") == 0)
             quick = 1;
-        else if (strcmp(argv[i], "--scaling") == 0)
-            mode = 1;
         else if (strcmp(argv[i], "--long-run") == 0)
-            mode = 2;
+            long_run_mode = 1;
         else if (strcmp(argv[i], "--repeats") == 0 && i + 1 < argc)
             repeats = atoi(argv[++i]);
         else if (strcmp(argv[i], "--case") == 0 && i + 1 < argc)
@@ -400,9 +340,8 @@ int main(int argc, char **argv)
             }
         } else {
             fprintf(stderr,
-                    "usage: %s [--quick] [--scaling | --long-run] [--repeats N] [--case NAME] [--out FILE]\n"
+                    "usage: %s [--quick] [--long-run] [--repeats N] [--case NAME] [--out FILE]\n"
                     "  (default) every back-end x rtol 1e-3..1e-12 on every case, TSV\n"
-                    "  --scaling   CPU per transition against chain length\n"
                     "  --long-run  phase drift over 1e4 stick-slip cycles, every back-end\n"
                     "  --repeats N at least N timed runs each (short runs repeat up to %d, to %.1f s)\n",
                     argv[0], MAX_REPEATS, MIN_TOTAL_CPU);
@@ -413,9 +352,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "--repeats: 1..%d\n", MAX_REPEATS);
         return 2;
     }
-    if (mode == 1)
-        scaling(out, quick);
-    else if (mode == 2)
+    if (long_run_mode)
         long_run(out, quick);
     else
         sweep(out, quick, repeats, only);

@@ -2,8 +2,9 @@
 # The work-precision benchmark (make bench): every back-end x every rtol on the paper's cases
 # and on Coulomb chains, CPU per transition against chain length, and phase drift over 1e4
 # stick-slip cycles.  Writes, under bench/:
-#   results.tsv, scaling.tsv, scaling_slopes.tsv, long_run.tsv, machine.txt, tables.md,
-#   wp_<case>.png (error vs CPU, log-log), scaling.png
+#   results.tsv, scaling.tsv, scaling_slopes.tsv (scripts/bench_scaling.sh), long_run.tsv,
+#   machine.txt, tables.md, wp_<case>.png (error vs CPU, log-log), scaling.png,
+#   scaling_memory.png
 # Takes about 15 minutes on the machine in bench/machine.txt; `scripts/bench.sh --quick` is
 # a smoke run into a temporary directory, `--plot-only` redraws the PNGs and tables from the
 # TSVs in bench/.
@@ -22,21 +23,13 @@ esac
 mkdir -p "$out"
 
 if [ $plot_only = 0 ]; then
-    {
-        echo "date: $(date -u +%Y-%m-%dT%H:%MZ)"
-        echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')"
-        echo "cores: $(nproc)"
-        echo "os: $(. /etc/os-release && echo "$PRETTY_NAME")"
-        echo "compiler: $(${CC:-cc} --version | head -1)"
-        echo "sundials: $(grep -m1 SUNDIALS_VERSION /usr/include/sundials/sundials_config.h | cut -d'"' -f2)"
-        echo "gsl: $(pkg-config --modversion gsl)"
-        echo "bksim: $(./bksim --version)"
-    } > "$out/machine.txt"
+    scripts/machine_info.sh > "$out/machine.txt"
 
     "$bench" "${quick[@]}" --out "$out/results.tsv"
-    "$bench" --scaling "${quick[@]}" --out "$out/scaling.tsv"
+    scripts/bench_scaling.sh $([ ${#quick[@]} -gt 0 ] && echo --quick) "$out"
     "$bench" --long-run "${quick[@]}" --out "$out/long_run.tsv"
 fi
+if [ $plot_only = 1 ]; then scripts/bench_scaling.sh --plot-only "$out"; fi
 
 # Columns of results.tsv, by name.
 col() { awk -F'\t' -v name="$1" 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == name) print i; exit }' "$out/results.tsv"; }
@@ -95,44 +88,6 @@ plot $plots
 GP
     rm -f "$out"/wp_"$case"_*.dat
 done
-
-# CPU per transition vs chain length, with a slope-1 guide; the slope of each curve from
-# 100 to 1000 blocks (least squares in log-log) into scaling_slopes.tsv.
-awk -F'\t' 'NR > 1 && $4 == "ok" && $2 >= 100 && $8 > 0 {
-        key = $1 "\t" $3; x = log($2); y = log($8)
-        n[key]++; sx[key] += x; sy[key] += y; sxx[key] += x * x; sxy[key] += x * y }
-    END { print "chain\tmethod\tpoints\tslope_100_1000"
-          for (k in n) if (n[k] >= 2) printf "%s\t%d\t%.3f\n", k, n[k],
-              (n[k] * sxy[k] - sx[k] * sy[k]) / (n[k] * sxx[k] - sx[k] * sx[k]) }' "$out/scaling.tsv" |
-    (read -r head; echo "$head"; sort) > "$out/scaling_slopes.tsv"
-plots=""
-k=0
-for chain in random uniform; do
-    for m in exact gsl_rk8pd cvode_adams arkode_dp45 cvode_bdf ida; do
-        f="$out/scaling_${chain}_$m.dat"
-        awk -F'\t' -v c="$chain" -v m="$m" 'NR > 1 && $1 == c && $3 == m && $4 == "ok" {print $2, $8}' "$out/scaling.tsv" > "$f"
-        if [ -s "$f" ]; then
-            dt=$([ $chain = uniform ] && echo 2 || echo 1)
-            label="$m$([ $chain = uniform ] && echo ' (uniform chain)' || true)$([ $m = cvode_bdf ] && echo ' (band)' || true)"
-            plots="$plots${plots:+, }'$f' using 1:2 with linespoints lw 2 dt $dt pt $((k % 13 + 1)) lc rgb '${colors[k % 12]}' title '$label'"
-        fi
-        k=$((k + 1))
-    done
-done
-gnuplot <<GP
-set terminal pngcairo size 1200,800 font 'Sans,12' noenhanced
-set output '$out/scaling.png'
-set title 'CPU time per transition vs chain length (Coulomb chain, rtol 1e-8, 0.5 s)'
-set logscale xy
-set xlabel 'blocks N'
-set ylabel 'CPU time per transition [s]'
-set format y '1e%L'
-set grid
-set key top left
-f(x) = 1e-6 * x
-plot $plots, f(x) with lines dt 3 lc rgb '#777777' title 'slope 1 (linear in N)'
-GP
-rm -f "$out"/scaling_*.dat
 
 scripts/bench_tables.sh "$out" > "$out/tables.md"
 # A full run into bench/ also refreshes the tables README quotes (between bench markers).

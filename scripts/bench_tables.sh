@@ -40,29 +40,34 @@ awk -F'\t' '
     }' "$results"
 echo
 
-# CPU per transition (ms) against N, heterogeneous chain, then the uniform one.
-awk -F'\t' '
+# CPU per transition (us) and peak resident memory (MB) against N, per chain; the window
+# (t_end) is the column's unless marked.
+window=$(awk -F'\t' 'NR == 2 {print $4}' "$dir/scaling.tsv")
+awk -F'\t' -v window="$window" '
     NR == 1 { next }
-    $4 == "ok" { key = $1 SUBSEP $2 SUBSEP $3; v[key] = sprintf("%.3g", 1000 * $8)
-                 if (!(($1 SUBSEP $3) in seen)) { seen[$1 SUBSEP $3] = 1; m[$1, ++nm[$1]] = $3 }
-                 if (!(($1 SUBSEP $2) in seenn)) { seenn[$1 SUBSEP $2] = 1; n[$1, ++nn[$1]] = $2 } }
+    { key = $1 SUBSEP $2 SUBSEP $3
+      if ($5 != "ok") v[key] = "failed"
+      else v[key] = sprintf("%.3g us, %.0f MB%s", 1e6 * $9, $10, $4 == window ? "" : sprintf(" (t_end %s s: %d transitions)", $4, $6))
+      if (!(($1 SUBSEP $3) in seen)) { seen[$1 SUBSEP $3] = 1; m[$1, ++nm[$1]] = $3 }
+      if (!(($1 SUBSEP $2) in seenn)) { seenn[$1 SUBSEP $2] = 1; n[$1, ++nn[$1]] = $2 } }
     END {
         split("random uniform", chains, " ")
         for (c = 1; c <= 2; ++c) {
             ch = chains[c]; if (!(ch in nm)) continue
-            printf "| N (%s chain) |", ch; for (j = 1; j <= nm[ch]; ++j) printf " %s |", m[ch, j]; print ""
+            printf "| N (%s chain), t_end %s s |", ch, window; for (j = 1; j <= nm[ch]; ++j) printf " %s |", m[ch, j]; print ""
             printf "| --- |"; for (j = 1; j <= nm[ch]; ++j) printf " --- |"; print ""
             for (i = 1; i <= nn[ch]; ++i) {
                 printf "| %s |", n[ch, i]
-                for (j = 1; j <= nm[ch]; ++j) { key = ch SUBSEP n[ch, i] SUBSEP m[ch, j]; printf " %s |", (key in v) ? v[key] " ms" : "-" }
+                for (j = 1; j <= nm[ch]; ++j) { key = ch SUBSEP n[ch, i] SUBSEP m[ch, j]; printf " %s |", (key in v) ? v[key] : "-" }
                 print ""
             }
             print ""
         }
     }' "$dir/scaling.tsv"
-echo "| chain | method | slope of CPU per transition vs N, 100 to 1000 blocks |"
-echo "| --- | --- | --- |"
-awk -F'\t' 'NR > 1 {printf "| %s | %s | %s |\n", $1, $2, $4}' "$dir/scaling_slopes.tsv"
+echo "| chain | method | sizes (same window) | slope of CPU per transition vs N | CPU per transition, 1e5 / 1e3 blocks |"
+echo "| --- | --- | --- | --- | --- |"
+awk -F'\t' 'NR > 1 {printf "| %s | %s | %s | %s | %s |\n", $1, $2, $4, $5, $6}' "$dir/scaling_slopes.tsv"
+[ -e "$dir/scaling_machine.txt" ] && echo && echo "Measured on: $(paste -sd ';' "$dir/scaling_machine.txt" | sed 's/;/; /g')"
 echo
 
 echo "| method (rtol 1e-8) | CPU | events | phase error, first 100 cycles | last 100 cycles | growth (last / first) |"

@@ -184,9 +184,13 @@ static void exact_state(exact_backend *eb, double t, double *y)
     size_t p = eb->p, m = eb->m;
     double tau = t - eb->t0;
     for (size_t k = 0; k < p; ++k) {
+        double ck = eb->c[k], gk = eb->g[k], dk = eb->d[k];
+        if (ck == 0.0 && gk == 0.0 && dk == 0.0) { /* idle (all but one mode of a uniform cluster) */
+            eb->eta[k] = eb->deta[k] = eb->ieta[k] = eb->idv[k] = 0.0;
+            continue;
+        }
         double phi[5], w2 = eb->omega2[k];
         basis(eb->omega[k], tau, phi);
-        double ck = eb->c[k], gk = eb->g[k], dk = eb->d[k];
         eb->eta[k] = ck * phi[1] + gk * phi[2] + dk * phi[3];
         eb->deta[k] = -w2 * ck * phi[2] + gk * phi[1] + dk * phi[2];
         eb->ieta[k] = ck * phi[2] + gk * phi[3] + dk * phi[4];
@@ -1150,51 +1154,64 @@ static int isolate_first(exact_backend *eb, double *lo, double *hi, bk_error *er
 }
 
 /* Look for crossings in (lo, hi] (values g at hi).  Returns 1 with *t_root and found[] when
- * some function crossed, 0 when none did, < 0 on failure. */
+ * some function crossed, 0 when none did, < 0 on failure.  Everything crossing within the
+ * root tolerance of the first crossing is one event, reported at the latest of their
+ * located times so that each has crossed there.  Only one function is located per round:
+ * the rest are sorted by evaluating all of them just before and just after its root, so a
+ * uniform stretch of p blocks stopping together costs one location, not p (each a few
+ * dozen probes of all p functions). */
 static int find_roots(exact_backend *eb, double lo, double hi, double *t_root, bk_error *err)
 {
     size_t nr = eb->n_roots;
     double *g = eb->g_hi;
-    for (int round = 0; round < 64; ++round) {
-        double first = INFINITY;
-        int any = 0;
-        for (size_t i = 0; i < nr; ++i) {
-            eb->root_t[i] = INFINITY;
-            if (!crossed(eb, i, g[i]))
-                continue;
-            int rc = locate(eb, i, lo, hi, g[i], &eb->root_t[i], err);
-            if (rc != BK_OK)
-                return rc;
-            first = fmin(first, eb->root_t[i]);
-            any = 1;
-        }
-        if (!any)
+    for (size_t round = 0; round < nr + 64; ++round) {
+        size_t pick = nr;
+        for (size_t i = 0; i < nr && pick == nr; ++i)
+            if (crossed(eb, i, g[i]))
+                pick = i;
+        if (pick == nr)
             return 0;
-        /* Everything crossing within the root tolerance of the first is one event, reported
-         * at the latest of their located times so that each has crossed there. */
-        double tol = 100.0 * DBL_EPSILON * (fabs(first) + eb->h);
-        double t = first;
-        for (size_t i = 0; i < nr; ++i)
-            if (eb->root_t[i] <= first + tol && eb->root_t[i] > t)
-                t = eb->root_t[i];
-        int rc = roots_at(eb, t, err);
+        double first;
+        int rc = locate(eb, pick, lo, hi, g[pick], &first, err);
         if (rc != BK_OK)
             return rc;
-        /* A function found crossing later whose sign has already flipped at t crossed more
-         * than once in (lo, hi]: look again in (lo, t]. */
-        int again = 0;
+        double tol = 100.0 * DBL_EPSILON * (fabs(first) + eb->h);
+        /* Another function crossed before this one's window: that crossing comes first. */
+        double before = first - tol;
+        if (before > lo) {
+            if ((rc = roots_at(eb, before, err)) != BK_OK)
+                return rc;
+            if (count_crossed(eb, eb->g_try) > 0) {
+                hi = before;
+                memcpy(g, eb->g_try, nr * sizeof *g);
+                continue;
+            }
+        }
+        /* Functions crossing just after it belong to the same event: locate those. */
+        double t = first, after = fmin(first + tol, hi);
+        if (after > first) {
+            if ((rc = roots_at(eb, after, err)) != BK_OK)
+                return rc;
+            memcpy(eb->root_t, eb->g_try, nr * sizeof *eb->root_t); /* values at after */
+            if ((rc = roots_at(eb, first, err)) != BK_OK)
+                return rc;
+            for (size_t i = 0; i < nr; ++i) {
+                if (!crossed(eb, i, eb->root_t[i]) || crossed(eb, i, eb->g_try[i]))
+                    continue;
+                double t_i;
+                if ((rc = locate(eb, i, first, after, eb->root_t[i], &t_i, err)) != BK_OK)
+                    return rc;
+                t = fmax(t, t_i);
+                /* locate probed elsewhere: the values at first are wanted again below. */
+                if ((rc = roots_at(eb, first, err)) != BK_OK)
+                    return rc;
+            }
+        }
+        if ((rc = roots_at(eb, t, err)) != BK_OK)
+            return rc;
         for (size_t i = 0; i < nr; ++i)
-            if (eb->root_t[i] > first + tol && crossed(eb, i, eb->g_try[i]))
-                again = 1;
-        if (again && t < hi) {
-            hi = t;
-            memcpy(g, eb->g_try, nr * sizeof *g);
-            continue;
-        }
-        for (size_t i = 0; i < nr; ++i) {
-            int hit = eb->root_t[i] <= first + tol || crossed(eb, i, eb->g_try[i]);
-            eb->found[i] = hit ? -eb->sign[i] : 0;
-        }
+            eb->found[i] = crossed(eb, i, eb->g_try[i]) ? -eb->sign[i] : 0;
+        eb->found[pick] = -eb->sign[pick];
         update_signs(eb, eb->g_try);
         for (size_t i = 0; i < nr; ++i)
             if (eb->found[i])

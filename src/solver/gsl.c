@@ -70,12 +70,22 @@ typedef struct gsl_backend {
     double max_step;            /* INFINITY when unlimited */
 
     gsl_odeiv2_system sys;
-    gsl_odeiv2_driver *driver;  /* owns step, control and evolve */
+    /* The objects a step uses.  msbdf carries history from step to step and reaches its
+     * control through a driver, so each instance owns one; the RK pairs carry nothing but
+     * evolve's dydt_out, which step() refills from f_lo, so they borrow shared ones. */
+    gsl_odeiv2_driver *driver;  /* msbdf: owns stepper, control and evolve */
+    struct shared_rk *shared;   /* RK: stepper, probe, evolve and control, borrowed */
+    gsl_odeiv2_step *stepper;
     gsl_odeiv2_step *probe;     /* second stepper for DENSE_RESTEP */
-    size_t driver_n;            /* the size driver and probe were made for */
+    gsl_odeiv2_evolve *evolve;
+    gsl_odeiv2_control *control;
+    size_t driver_n;            /* msbdf: the size the driver was made for */
+    gsl_root_fsolver *brent;    /* event location, made at the first event */
     size_t n, capacity;         /* state size; allocated length of the arrays below */
     double *arena;              /* every array below but active and found */
-    double *y_lo, *f_lo, *y_hi, *f_hi, *y_root, *y_probe, *atol, *work, *work2, *yerr;
+    double *y_lo, *f_lo, *y_hi, *f_hi, *y_root, *y_probe, *atol, *work, *work2, *yerr,
+           *scale; /* the control's absolute weights: atol_i / eps_abs */
+    double eps_abs;
     size_t root_capacity;
     double *g_scan, *g_hi, *g_probe, *g_root;
     int *active, *found;
@@ -149,6 +159,143 @@ static int eval_roots(gsl_backend *b, double t, const double *y, double *g)
         if (!isfinite(g[i]))
             return -1;
     return 0;
+}
+
+/* --- step-size control and shared RK objects ------------------------------------------- */
+
+/* GSL's scaled control (D_i = eps_abs scale_i + eps_rel |y_i|, with a_y = 1, a_dydt = 0)
+ * reading its weights through a pointer instead of a copy made at allocation, so that one
+ * control serves islands whose layouts differ.  hadjust is GSL's heuristic as documented
+ * (decrease when the error exceeds D by 10 %, by S / r^(1/q) but at most 5 times;
+ * increase when below half, by S / r^(1/(q+1)) at most 4.9 times; S = 0.9), evaluated
+ * in GSL's order so that steps are bit-identical to gsl_odeiv2_control_scaled's. */
+typedef struct scaled_control {
+    double eps_abs, eps_rel;
+    const double *scale;
+} scaled_control;
+
+static void *control_alloc(void)
+{
+    return calloc(1, sizeof(scaled_control));
+}
+
+static int control_init(void *state, double eps_abs, double eps_rel, double a_y, double a_dydt)
+{
+    (void)a_y;
+    (void)a_dydt;
+    scaled_control *c = state;
+    c->eps_abs = eps_abs;
+    c->eps_rel = eps_rel;
+    return GSL_SUCCESS;
+}
+
+static int control_hadjust(void *state, size_t dim, unsigned int ord, const double y[],
+                           const double yerr[], const double yp[], double *h)
+{
+    (void)yp;
+    const scaled_control *c = state;
+    const double S = 0.9, h_old = *h;
+    double rmax = DBL_MIN;
+    for (size_t i = 0; i < dim; ++i) {
+        double d0 = c->eps_rel * fabs(y[i]) + c->eps_abs * c->scale[i];
+        double r = fabs(yerr[i]) / fabs(d0);
+        rmax = r > rmax ? r : rmax;
+    }
+    if (rmax > 1.1) {
+        double r = S / pow(rmax, 1.0 / ord);
+        *h = (r < 0.2 ? 0.2 : r) * h_old;
+        return GSL_ODEIV_HADJ_DEC;
+    }
+    if (rmax < 0.5) {
+        double r = S / pow(rmax, 1.0 / (ord + 1.0));
+        r = r > 4.9 ? 4.9 : r;
+        *h = (r < 1.0 ? 1.0 : r) * h_old;
+        return GSL_ODEIV_HADJ_INC;
+    }
+    return GSL_ODEIV_HADJ_NIL;
+}
+
+static int control_errlevel(void *state, double y, double dydt, double h, size_t ind, double *errlev)
+{
+    (void)dydt;
+    (void)h;
+    const scaled_control *c = state;
+    *errlev = c->eps_rel * fabs(y) + c->eps_abs * c->scale[ind];
+    return *errlev > 0.0 ? GSL_SUCCESS : GSL_ESANITY;
+}
+
+static int control_set_driver(void *state, const gsl_odeiv2_driver *d)
+{
+    (void)state;
+    (void)d;
+    return GSL_SUCCESS;
+}
+
+static const gsl_odeiv2_control_type scaled_control_type = {
+    "bksim scaled", control_alloc, control_init, control_hadjust, control_errlevel,
+    control_set_driver, free};
+
+/* The RK objects of one size, shared by this thread's instances: a long chain runs
+ * thousands of islands in turn, and objects of their own (16 n doubles of stages and
+ * copies in a dozen allocations) would be cold at every turn.  Sharing is exact: an RK
+ * step reads nothing left by the last one except evolve's dydt_out, refilled per step.
+ * Reference-counted; an instance stays in the thread that made it. */
+typedef struct shared_rk {
+    const gsl_odeiv2_step_type *type;
+    size_t n, users;
+    gsl_odeiv2_step *stepper, *probe;
+    gsl_odeiv2_evolve *evolve;
+    gsl_odeiv2_control *control;
+    struct shared_rk *next; /* same bucket */
+} shared_rk;
+
+#define SHARED_BUCKETS 64
+static _Thread_local shared_rk *shared_table[SHARED_BUCKETS];
+
+static void shared_free(shared_rk *s)
+{
+    if (s->stepper)
+        gsl_odeiv2_step_free(s->stepper);
+    if (s->probe)
+        gsl_odeiv2_step_free(s->probe);
+    if (s->evolve)
+        gsl_odeiv2_evolve_free(s->evolve);
+    if (s->control)
+        gsl_odeiv2_control_free(s->control);
+    free(s);
+}
+
+static shared_rk *shared_acquire(const gsl_odeiv2_step_type *type, size_t n)
+{
+    shared_rk **bucket = &shared_table[n % SHARED_BUCKETS];
+    for (shared_rk *s = *bucket; s; s = s->next)
+        if (s->type == type && s->n == n) {
+            s->users++;
+            return s;
+        }
+    shared_rk *s = calloc(1, sizeof *s);
+    if (!s)
+        return NULL;
+    *s = (shared_rk){type, n, 1, gsl_odeiv2_step_alloc(type, n), gsl_odeiv2_step_alloc(type, n),
+                     gsl_odeiv2_evolve_alloc(n), gsl_odeiv2_control_alloc(&scaled_control_type), *bucket};
+    if (!s->stepper || !s->probe || !s->evolve || !s->control) {
+        shared_free(s);
+        return NULL;
+    }
+    *bucket = s;
+    return s;
+}
+
+static void shared_release(shared_rk *s)
+{
+    if (!s || --s->users > 0)
+        return;
+    for (shared_rk **link = &shared_table[s->n % SHARED_BUCKETS]; *link; link = &(*link)->next)
+        if (*link == s) {
+            *link = s->next;
+            break;
+        }
+    shared_free(s);
 }
 
 /* --- dense output ---------------------------------------------------------------------- */
@@ -229,7 +376,9 @@ static void bracket(gsl_backend *b, size_t i, double lo, double hi, double *a, d
     if (b->status != 0)
         return;
     if (f_lo > 0.0 && f_hi < 0.0) {
-        gsl_root_fsolver *solver = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
+        if (!b->brent)
+            b->brent = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
+        gsl_root_fsolver *solver = b->brent;
         if (solver && gsl_root_fsolver_set(solver, &fn, lo, hi) == GSL_SUCCESS) {
             for (int iter = 0; iter < 100 && !converged(*a, *c); ++iter) {
                 if (gsl_root_fsolver_iterate(solver) != GSL_SUCCESS || b->status != 0)
@@ -238,7 +387,6 @@ static void bracket(gsl_backend *b, size_t i, double lo, double hi, double *a, d
                 *c = gsl_root_fsolver_x_upper(solver);
             }
         }
-        gsl_root_fsolver_free(solver);
         if (b->status != 0)
             return;
         /* Brent keeps a sign change, not necessarily this orientation (several zeros). */
@@ -344,10 +492,13 @@ static void free_steppers(gsl_backend *b)
 {
     if (b->driver)
         gsl_odeiv2_driver_free(b->driver);
-    if (b->probe)
-        gsl_odeiv2_step_free(b->probe);
+    shared_release(b->shared);
     b->driver = NULL;
-    b->probe = NULL;
+    b->shared = NULL;
+    b->stepper = b->probe = NULL;
+    b->evolve = NULL;
+    b->control = NULL;
+    b->driver_n = 0;
 }
 
 static void free_arrays(gsl_backend *b)
@@ -367,7 +518,7 @@ static int reserve(gsl_backend *b, size_t n, size_t m)
     if (n <= b->capacity && m <= b->root_capacity)
         return 0;
     size_t cap_n = n > b->capacity ? n : b->capacity, cap_m = m > b->root_capacity ? m : b->root_capacity;
-    double *arena = malloc((10 * cap_n + 4 * cap_m + 1) * sizeof *arena);
+    double *arena = malloc((11 * cap_n + 4 * cap_m + 1) * sizeof *arena);
     int *flags = malloc((2 * cap_m + 1) * sizeof *flags);
     if (!arena || !flags) {
         free(arena);
@@ -375,17 +526,16 @@ static int reserve(gsl_backend *b, size_t n, size_t m)
         return -1;
     }
     double **arrays[] = {&b->y_lo, &b->f_lo, &b->y_hi, &b->f_hi, &b->y_root, &b->y_probe,
-                         &b->atol, &b->work, &b->work2, &b->yerr};
+                         &b->atol, &b->scale, &b->work, &b->work2, &b->yerr};
     double **roots[] = {&b->g_scan, &b->g_hi, &b->g_probe, &b->g_root};
     double *next = arena;
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; ++k, next += cap_n)
         *arrays[k] = next;
     for (size_t k = 0; k < sizeof roots / sizeof *roots; ++k, next += cap_m)
         *roots[k] = next;
-    /* Nothing carries over: a start fills what it needs, and the driver points at work, so
-     * it is made anew. */
+    /* Nothing carries over: a start fills what it needs (msbdf's driver is made anew, as
+     * the weights it was made for are gone). */
     free_steppers(b);
-    b->driver_n = 0;
     free(b->arena);
     free(b->active);
     b->arena = arena;
@@ -496,30 +646,43 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     for (size_t i = 0; i < n; ++i)
         b->work[i] = eps_abs > 0.0 ? atol[i] / eps_abs : 0.0;
     double factor = b->variant->tolerance_factor;
-    double h_start = b->h > 0.0 ? b->h : 1.0;
-    if (b->driver && b->driver_n == n) {
-        /* Same size: reset what exists rather than allocate anew (an island restarts at
-         * every event; allocating there dominated on long chains).  Reset, the objects
-         * start exactly as new ones do. */
+    if (b->variant->dense == DENSE_RESTEP) {
+        if (!b->shared || b->shared->n != n) {
+            free_steppers(b);
+            b->shared = shared_acquire(*b->variant->type, n);
+            if (b->shared) {
+                b->stepper = b->shared->stepper;
+                b->probe = b->shared->probe;
+                b->evolve = b->shared->evolve;
+                b->control = b->shared->control;
+            }
+        }
+    } else if (b->driver && b->driver_n == n && eps_abs == b->eps_abs &&
+               memcmp(b->work, b->scale, n * sizeof *b->work) == 0) {
+        /* The tolerances the driver was made for (its control copied the weights): reset
+         * rather than allocate anew, as an island restarts at every event.  Reset, the
+         * objects start exactly as new ones do. */
         gsl_odeiv2_driver_reset(b->driver);
-        gsl_odeiv2_control_init(b->driver->c, factor * eps_abs, factor * b->options.rtol, 1.0, 0.0);
-        gsl_odeiv2_driver_reset_hstart(b->driver, h_start);
-        /* The probe re-steps from the step's start with its derivative given each time: it
-         * keeps nothing between uses, so it needs no reset. */
+        gsl_odeiv2_driver_reset_hstart(b->driver, b->h > 0.0 ? b->h : 1.0);
     } else {
         free_steppers(b);
-        b->driver = gsl_odeiv2_driver_alloc_scaled_new(&b->sys, *b->variant->type, h_start,
+        b->driver = gsl_odeiv2_driver_alloc_scaled_new(&b->sys, *b->variant->type, b->h > 0.0 ? b->h : 1.0,
                                                        factor * eps_abs, factor * b->options.rtol,
                                                        1.0, 0.0, b->work);
-        if (b->variant->dense == DENSE_RESTEP)
-            b->probe = gsl_odeiv2_step_alloc(*b->variant->type, n);
-        b->driver_n = n;
+        if (b->driver) {
+            b->stepper = b->driver->s;
+            b->evolve = b->driver->e;
+            b->control = b->driver->c;
+            b->driver_n = n;
+        }
     }
-    if (!b->driver || (b->variant->dense == DENSE_RESTEP && !b->probe)) {
+    if (!b->stepper) {
         free_steppers(b);
         return BK_FAIL(err, BK_ERR_NOMEM, "GSL %s: cannot allocate the stepper (n = %zu)",
                        b->variant->label, n);
     }
+    memcpy(b->scale, b->work, n * sizeof *b->work);
+    b->eps_abs = eps_abs;
 
     /* Roots: functions exactly zero at t0 wait until they are not; probe them just past
      * t0 along f, as CVODE does. */
@@ -602,11 +765,19 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
     /* Over-ask at the end so that evolve takes its final-step branch, which lands on
      * t_stop exactly and leaves the suggested step alone. */
     double h_in = h >= remaining ? 2.0 * remaining : h;
-    gsl_odeiv2_evolve *e = b->driver->e;
+    gsl_odeiv2_evolve *e = b->evolve;
+    if (b->shared) {
+        scaled_control *c = b->control->state;
+        c->eps_abs = b->variant->tolerance_factor * b->eps_abs;
+        c->eps_rel = b->variant->tolerance_factor * b->options.rtol;
+        c->scale = b->scale;
+        /* What evolve would reuse as the step's initial derivative: f at its start. */
+        memcpy(e->dydt_out, b->f_lo, n * sizeof *y);
+        e->count = 1;
+    }
     unsigned long failed = e->failed_steps;
     b->rhs_status = 0;
-    int status = gsl_odeiv2_evolve_apply(e, b->driver->c, b->driver->s, &b->sys, &t, b->t_stop,
-                                         &h_in, b->y_hi);
+    int status = gsl_odeiv2_evolve_apply(e, b->control, b->stepper, &b->sys, &t, b->t_stop, &h_in, b->y_hi);
     b->count.err_test_fails += (long)(e->failed_steps - failed);
     if (status != GSL_SUCCESS) {
         memcpy(b->y_hi, b->y_lo, n * sizeof *y);
@@ -619,7 +790,7 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
     b->t_hi = t;
     b->stepped = 1;
     b->count.steps++;
-    if (b->driver->s->type->gives_exact_dydt_out) {
+    if (b->stepper->type->gives_exact_dydt_out) {
         memcpy(b->f_hi, e->dydt_out, n * sizeof *y);
     } else if (rhs_adapter(t, b->y_hi, b->f_hi, b) != GSL_SUCCESS) {
         return step_failed(b, GSL_EBADFUNC, t, err);
@@ -684,6 +855,7 @@ static void destroy(void *mem)
     if (!b)
         return;
     free_steppers(b);
+    gsl_root_fsolver_free(b->brent);
     free_arrays(b);
     free(b);
 }
