@@ -76,7 +76,7 @@ static const key_def keys[] = {
         "driver position at t = 0 (0: at the relaxed blocks)"),
 
     {"solver", {"method", "", 0, 0, 0, 0,
-                "integrator back-end; auto: exact for Coulomb scenes (short chains), else gsl_rk8pd, or cvode_bdf when stiff (README \"Solver back-ends\")"},
+                "integrator back-end; auto: exact for Coulomb scenes (open chains up to 1000 blocks, rings up to 100), else gsl_rk8pd, or cvode_bdf when stiff (README \"Solver back-ends\")"},
      BK_KEY_CHOICE, NULL, bk_config_method_name, "auto"},
     {"solver", {"linear_solver", "", 0, 0, 0, 0, "linear solver of implicit methods: auto (band for long chains), dense, band"},
      BK_KEY_CHOICE, bk_config_linear_solver_names, NULL, "auto"},
@@ -118,8 +118,9 @@ static const key_def keys[] = {
                 "/transitions table holds the changed block's state anyway); auto: true up to 16 blocks"},
      BK_KEY_BOOLEAN, NULL, NULL, "auto"},
     NUM("output", "max_bytes", "B", 1e10, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
-        "largest size the sample rows (t_end / interval, times the bytes per row for the fields and blocks) "
-        "may take: a guard against a typo in interval or n_blocks"),
+        "largest size the output may take: the sample rows (t_end / interval, times the bytes per row for "
+        "the fields and blocks) are checked at load, against a typo in interval or n_blocks; event rows and "
+        "transitions as they are written, and the run stops with an error there"),
     INT("output", "max_rows", 1e8, 1, 1e15, 0,
         "largest number of sample rows (t_end / interval) a run may write: a guard against a typo in interval"),
     NUM("output", "checkpoint_interval", "s", 0.0, 0.0, INFINITY, 0,

@@ -1,7 +1,7 @@
 /* method = auto: the cheapest adequate back-end for the scene, from bench/ measurements.
  *
  * A Coulomb scene is linear with constant coefficients between transitions, so the exact
- * stepper is both exact and the fastest (up to AUTO_EXACT_MAX_BLOCKS blocks).  Otherwise an
+ * stepper is both exact and the fastest (up to AUTO_EXACT_MAX_BLOCKS blocks, see there).  Otherwise an
  * explicit Runge-Kutta pair is cheapest unless the problem is stiff.  The stiffness measure
  * is the fastest decay rate of the linearised problem over its fastest oscillation
  * frequency, on a probe state (every block sliding at the driver speed, initial friction
@@ -19,10 +19,19 @@
 #include "bksim/driver.h"
 #include "method_choice.h"
 
-/* 100: per transition the exact stepper grows linearly with N on scattered slips (3.6x
- * faster than CVODE at 100 blocks), but a whole-chain slide is one cluster, still cubic per
- * restart (a uniform 1000-block chain: 9.4 s against 0.03 s for cvode_adams). */
-#define AUTO_EXACT_MAX_BLOCKS 100
+/* Largest Coulomb chain auto gives the exact stepper; measured per transition, exact vs
+ * gsl_rk8pd at default tolerances (bench/ machine):
+ *   random chain (bk1000_coulomb.ini), 2 s:  1e3 blocks 9.6 vs 18 us, 1e5 blocks 18 vs 27 us;
+ *   uniform chain (slides as one):           1e3 blocks 6.5 vs 8 us;
+ *   nearly uniform (x_init_random = 1e-9, slips spread over one growing cluster, each
+ *   transition restarting it: O(p^2) for exact's eigen-solver, O(p) for the integrator):
+ *   1e3 blocks 1.1 ms vs 0.35 ms, 3e3 blocks 3.8 vs 0.9 ms.
+ * So exact up to 1e3 blocks (2x faster on the usual heterogeneous chain, 3x slower at
+ * worst); beyond, the worst case grows with N and the integrator is the safe default.  A
+ * ring that slips all round is one cyclic cluster, dense and p^3 per restart (1e3 nearly
+ * uniform blocks: 4.9 ms vs 0.37 ms per transition), so rings keep the earlier 100. */
+#define AUTO_EXACT_MAX_BLOCKS 1000
+#define AUTO_EXACT_MAX_RING 100
 #define STIFF_RATIO 50.0
 
 typedef struct probe_matrix {
@@ -89,7 +98,8 @@ const char *bk_choose_method(const bk_config *config, const bk_scene *scene)
 {
     if (strcmp(config->solver.method, "auto") != 0)
         return config->solver.method;
-    if (scene->affine && scene->n <= AUTO_EXACT_MAX_BLOCKS)
+    size_t exact_max = config->model->boundary == BK_BOUNDARY_PERIODIC ? AUTO_EXACT_MAX_RING : AUTO_EXACT_MAX_BLOCKS;
+    if (scene->affine && scene->n <= exact_max)
         return "exact";
     double ratio = bk_stiffness_ratio(config->model);
     return ratio <= STIFF_RATIO ? "gsl_rk8pd" : "cvode_bdf"; /* NaN (no probe): the safe one */

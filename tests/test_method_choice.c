@@ -58,22 +58,27 @@ static void test_choices(void **state)
 {
     (void)state;
     static const struct {
-        const char *config, *override, *method;
+        const char *config, *override, *method, *override2;
     } cases[] = {
-        {"configs/paper/case_a_coulomb.ini", NULL, "exact"},
-        {"configs/paper/case_c_coulomb_tension_only.ini", NULL, "exact"},
-        {"configs/chains/bk10_coulomb.ini", NULL, "exact"},
-        {"configs/paper/case_a_rs.ini", NULL, "gsl_rk8pd"},
-        {"configs/paper/case_b_rs.ini", NULL, "gsl_rk8pd"},
-        {"configs/paper/case_c_rs.ini", NULL, "gsl_rk8pd"},
-        {"configs/paper/case_b_rs.ini", "friction.L0=2e-6", "gsl_rk8pd"},
-        {"configs/paper/case_b_rs.ini", "friction.L0=2e-7", "cvode_bdf"},
-        {"configs/paper/case_b_rs.ini", "friction.L0=2e-8", "cvode_bdf"},
-        {"configs/paper/case_b_rs.ini", "solver.method=ida", "ida"},
+        {"configs/paper/case_a_coulomb.ini", NULL, "exact", NULL},
+        /* Open Coulomb chains up to 1000 blocks, rings up to 100 (see method_choice.c). */
+        {"configs/chains/bk1000_coulomb.ini", NULL, "exact", NULL},
+        {"configs/chains/bk1000_coulomb.ini", "model.n_blocks=1001", "gsl_rk8pd", NULL},
+        {"configs/chains/bk1000_coulomb.ini", "model.boundary=periodic", "gsl_rk8pd", "model.n_blocks=101"},
+        {"configs/chains/bk1000_coulomb.ini", "model.boundary=periodic", "exact", "model.n_blocks=100"},
+        {"configs/paper/case_c_coulomb_tension_only.ini", NULL, "exact", NULL},
+        {"configs/chains/bk10_coulomb.ini", NULL, "exact", NULL},
+        {"configs/paper/case_a_rs.ini", NULL, "gsl_rk8pd", NULL},
+        {"configs/paper/case_b_rs.ini", NULL, "gsl_rk8pd", NULL},
+        {"configs/paper/case_c_rs.ini", NULL, "gsl_rk8pd", NULL},
+        {"configs/paper/case_b_rs.ini", "friction.L0=2e-6", "gsl_rk8pd", NULL},
+        {"configs/paper/case_b_rs.ini", "friction.L0=2e-7", "cvode_bdf", NULL},
+        {"configs/paper/case_b_rs.ini", "friction.L0=2e-8", "cvode_bdf", NULL},
+        {"configs/paper/case_b_rs.ini", "solver.method=ida", "ida", NULL},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
-        const char *overrides[] = {cases[k].override};
-        bk_config *c = load(cases[k].config, overrides, cases[k].override ? 1 : 0);
+        const char *overrides[] = {cases[k].override, cases[k].override2};
+        bk_config *c = load(cases[k].config, overrides, cases[k].override2 ? 2 : cases[k].override ? 1 : 0);
         const char *method = choice(c);
         if (strcmp(method, cases[k].method) != 0)
             print_message("%s %s: %s, expected %s\n", cases[k].config, cases[k].override ? cases[k].override : "",

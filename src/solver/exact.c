@@ -27,10 +27,11 @@
  * modal period (and max_step); a sign change is located by GSL's Brent on the exact solution
  * to the last few representable doubles and reported with the state just after the crossing,
  * as CVODE does.  A function exactly zero at the start stays inactive until it moves away
- * from zero (CVODE's convention).  A long chain has many transitions per sampling step, so a
- * step with several crossings is first halved toward the earliest, and only that one located:
- * the problem's root functions cover the whole chain, so each probe costs O(N) however small
- * the cluster, and the number of probes per transition is what must stay bounded.
+ * from zero (CVODE's convention).  A long island can have several transitions per sampling
+ * step, and every probe evaluates all its root functions, so the number of probes per
+ * transition is what must stay bounded: a step with several crossings is first halved toward
+ * the earliest, then one function is located and the others sorted by two evaluations
+ * around its root (find_roots).
  *
  * Why.  It is the accuracy yardstick for the integrators (transition times to ~1e-15
  * relative, including case C's grazing stops that no tolerance-driven integrator resolves)
