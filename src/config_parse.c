@@ -213,21 +213,29 @@ static int parse_bool(const char *text, double *out)
     return -1;
 }
 
+/* The next word of a list separated by commas and/or blanks: 1 with *start and *len, 0 at
+ * the end; *p moves past it. */
+static int next_word(const char **p, const char **start, size_t *len)
+{
+    while (**p == ',' || isspace((unsigned char)**p))
+        ++*p;
+    if (!**p)
+        return 0;
+    *start = *p;
+    while (**p && **p != ',' && !isspace((unsigned char)**p))
+        ++*p;
+    *len = (size_t)(*p - *start);
+    return 1;
+}
+
 /* Parse a "fields" list into a BK_FIELD_* mask; -1 and the bad word on failure. */
 static int parse_fields(const char *text, double *out, char *bad, size_t bad_len)
 {
     unsigned mask = 0;
-    const char *p = text;
+    const char *p = text, *start;
+    size_t len;
     int words = 0;
-    while (*p) {
-        while (*p == ',' || isspace((unsigned char)*p))
-            ++p;
-        if (!*p)
-            break;
-        const char *start = p;
-        while (*p && *p != ',' && !isspace((unsigned char)*p))
-            ++p;
-        size_t len = (size_t)(p - start);
+    while (next_word(&p, &start, &len)) {
         ++words;
         if (len == 3 && strncmp(start, "all", 3) == 0) {
             mask = BK_FIELD_ALL;
@@ -307,16 +315,11 @@ int bk_config_check_value(loader *ld, entry *e, const key_def *def, const bk_par
             ld->oom = 1;
             return -1;
         }
-        for (const char *p = v;;) {
-            while (*p == ',' || isspace((unsigned char)*p))
-                ++p;
-            if (!*p)
-                break;
-            const char *start = p;
-            while (*p && *p != ',' && !isspace((unsigned char)*p))
-                ++p;
+        const char *p = v, *start;
+        size_t len;
+        while (next_word(&p, &start, &len)) {
             char word[64];
-            snprintf(word, sizeof word, "%.*s", (int)(p - start), start);
+            snprintf(word, sizeof word, "%.*s", (int)len, start);
             double x;
             if (parse_number(word, &x) || !bk_param_in_range(param, x)) {
                 bk_config_report_entry(ld, e, "bad value \"%s\" (item %zu) (allowed: %s)", word, count + 1, allowed);

@@ -443,6 +443,21 @@ static int found_island(run_ctx *ctx, long lo, long hi, double t)
     return start_island(ctx, id, t);
 }
 
+/* The slipping runs [group_lo, group_hi] become one island with the stuck blocks around
+ * them (clipped at a free chain's ends); the blocks from *next_quiet up to it go quiet. */
+static int close_group(run_ctx *ctx, long group_lo, long group_hi, long *next_quiet, double t)
+{
+    long n = (long)ctx->scene.n, a = group_lo - 1, b = group_hi + 1;
+    if (!periodic(ctx)) {
+        a = a < 0 ? 0 : a;
+        b = b > n - 1 ? n - 1 : b;
+    }
+    for (long q = *next_quiet; q < a; ++q)
+        make_quiet(ctx, wrap(ctx, q), t);
+    *next_quiet = b + 1;
+    return found_island(ctx, a, b, t);
+}
+
 /* Rebuild islands and quiet blocks over chain positions [lo, hi] (unwrapped; every block
  * there belongs to no island, and the blocks at both ends are stuck unless they are chain
  * ends), or over the whole ring.  Slipping runs that one stuck block separates form one
@@ -483,31 +498,13 @@ static int rebuild(run_ctx *ctx, long lo, long hi, int whole_ring, double t)
             group_hi = j; /* one stuck block between: the same island */
             continue;
         }
-        if (group_hi >= group_lo) {
-            long a = group_lo - 1, b = group_hi + 1;
-            if (!periodic(ctx)) {
-                a = a < 0 ? 0 : a;
-                b = b > n - 1 ? n - 1 : b;
-            }
-            for (long q = next_quiet; q < a; ++q)
-                make_quiet(ctx, wrap(ctx, q), t);
-            rc = found_island(ctx, a, b, t);
-            next_quiet = b + 1;
-        }
+        if (group_hi >= group_lo)
+            rc = close_group(ctx, group_lo, group_hi, &next_quiet, t);
         group_lo = run_lo;
         group_hi = j;
     }
-    if (rc == BK_OK && group_hi >= group_lo) {
-        long a = group_lo - 1, b = group_hi + 1;
-        if (!periodic(ctx)) {
-            a = a < 0 ? 0 : a;
-            b = b > n - 1 ? n - 1 : b;
-        }
-        for (long q = next_quiet; q < a; ++q)
-            make_quiet(ctx, wrap(ctx, q), t);
-        rc = found_island(ctx, a, b, t);
-        next_quiet = b + 1;
-    }
+    if (rc == BK_OK && group_hi >= group_lo)
+        rc = close_group(ctx, group_lo, group_hi, &next_quiet, t);
     for (long q = next_quiet; rc == BK_OK && q <= hi; ++q)
         make_quiet(ctx, wrap(ctx, q), t);
     return rc;

@@ -258,37 +258,36 @@ static int export_series_table(hid_t file, const char *path, const char *dataset
     return rc;
 }
 
+typedef struct export_filter {
+    long block; /* < 0: all */
+    FILE *out;
+} export_filter;
+
+static void transitions_header(FILE *out)
+{
+    fprintf(out, "# t[s] block[1] from[1] to[1] x[m] v[m/s] force[N]\n");
+}
+
+static int print_transition(const bk_transition *t, unsigned long long row, void *user, bk_error *err)
+{
+    (void)err;
+    const export_filter *f = user;
+    if (row == 0)
+        transitions_header(f->out); /* once the table opened */
+    if (f->block < 0 || t->block == f->block)
+        fprintf(f->out, "%.17g %d %d %d %.17g %.17g %.17g\n", t->t, (int)t->block, (int)t->from,
+                (int)t->to, t->x, t->v, t->force);
+    return BK_OK;
+}
+
 static int export_transitions(hid_t file, const char *path, long block, FILE *out,
                               bk_error *err)
 {
-    hid_t dset, mem;
-    hsize_t count;
-    int rc = bk_h5_open_transitions(file, path, &dset, &mem, &count, err);
-    if (rc != BK_OK)
-        return rc;
-    bk_transition *buf = malloc(TRANSITION_BUFFER * sizeof *buf);
-    if (!buf)
-        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
-    else
-        fprintf(out, "# t[s] block[1] from[1] to[1] x[m] v[m/s] force[N]\n");
-    for (hsize_t start = 0; rc == BK_OK && start < count; start += TRANSITION_BUFFER) {
-        size_t n = (size_t)(count - start);
-        if (n > TRANSITION_BUFFER)
-            n = TRANSITION_BUFFER;
-        if (bk_h5_read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
-            rc = H5_FAIL(err, "%s: cannot read /transitions", path);
-            break;
-        }
-        for (size_t k = 0; k < n; ++k) {
-            const bk_transition *t = &buf[k];
-            if (block >= 0 && t->block != block)
-                continue;
-            fprintf(out, "%.17g %d %d %d %.17g %.17g %.17g\n", t->t, (int)t->block,
-                    (int)t->from, (int)t->to, t->x, t->v, t->force);
-        }
-    }
-    free(buf);
-    CLOSE_IDS(0, mem, dset);
+    export_filter filter = {block, out};
+    hsize_t count = 0;
+    int rc = bk_h5_each_transition(file, path, print_transition, &filter, &count, err);
+    if (rc == BK_OK && count == 0)
+        transitions_header(out);
     return rc;
 }
 

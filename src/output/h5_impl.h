@@ -143,6 +143,12 @@ int bk_h5_open_series(hid_t file, const char *path, const char *name, hid_t *dse
 /* Opens /transitions and its memory type; count = rows. */
 int bk_h5_open_transitions(hid_t file, const char *path, hid_t *dset, hid_t *mem,
                            hsize_t *count, bk_error *err);
+/* Every /transitions record in order (read TRANSITION_BUFFER at a time) through visit, which
+ * returns BK_OK to go on; *count gets the table's length. */
+typedef int (*bk_h5_transition_visit)(const bk_transition *t, unsigned long long row, void *user,
+                                      bk_error *err);
+int bk_h5_each_transition(hid_t file, const char *path, bk_h5_transition_visit visit, void *user,
+                          hsize_t *count, bk_error *err);
 /* Rows [start, start + count) and columns [col, col + ncols) as mem_type. */
 herr_t bk_h5_read_block(hid_t dset, int rank, hsize_t start, hsize_t count, hsize_t col,
                         hsize_t ncols, hid_t mem_type, void *buf);

@@ -105,12 +105,28 @@ static void print_indented(FILE *out, const char *text)
     }
 }
 
+typedef struct phase_counts {
+    const char *path;
+    size_t n_blocks;
+    long *stick, *slip;
+} phase_counts;
+
+static int count_phase(const bk_transition *t, unsigned long long row, void *user, bk_error *err)
+{
+    const phase_counts *c = user;
+    if (t->block < 0 || (size_t)t->block >= c->n_blocks)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu names block %d, outside 0..%zu",
+                       c->path, row, (int)t->block, c->n_blocks - 1);
+    ++*(t->to == 0 ? &c->stick[t->block] : &c->slip[t->block]);
+    return BK_OK;
+}
+
 /* Stick and slip phases per block: each transition starts a phase of its `to` mode, and
  * row 0 of /mode starts the first one. */
 static int count_phases(hid_t file, const char *path, size_t n_blocks, long *stick, long *slip,
                         long *total, int *have_transitions, bk_error *err)
 {
-    hid_t dset, mem;
+    hid_t dset;
     hsize_t rows, cols;
     int rank;
     *total = 0;
@@ -128,35 +144,11 @@ static int count_phases(hid_t file, const char *path, size_t n_blocks, long *sti
     }
     if (H5Lexists(file, "transitions", H5P_DEFAULT) <= 0)
         return BK_OK;
-    hsize_t count;
-    int rc = bk_h5_open_transitions(file, path, &dset, &mem, &count, err);
-    if (rc != BK_OK)
-        return rc;
     *have_transitions = 1;
-    bk_transition *buf = malloc(TRANSITION_BUFFER * sizeof *buf);
-    if (!buf)
-        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
-    for (hsize_t start = 0; rc == BK_OK && start < count; start += TRANSITION_BUFFER) {
-        size_t n = (size_t)(count - start);
-        if (n > TRANSITION_BUFFER)
-            n = TRANSITION_BUFFER;
-        if (bk_h5_read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
-            rc = H5_DAMAGED(err, "%s: damaged: /transitions cannot be read", path);
-            break;
-        }
-        for (size_t k = 0; k < n; ++k) {
-            if (buf[k].block < 0 || (size_t)buf[k].block >= n_blocks) {
-                rc = BK_FAIL(err, BK_ERR_DAMAGED,
-                             "%s: damaged: /transitions row %llu names block %d, outside 0..%zu", path,
-                             (unsigned long long)(start + k), (int)buf[k].block, n_blocks - 1);
-                break;
-            }
-            ++*(buf[k].to == 0 ? &stick[buf[k].block] : &slip[buf[k].block]);
-        }
-    }
+    phase_counts counts = {path, n_blocks, stick, slip};
+    hsize_t count = 0;
+    int rc = bk_h5_each_transition(file, path, count_phase, &counts, &count, err);
     *total = (long)count;
-    free(buf);
-    CLOSE_IDS(0, mem, dset);
     return rc;
 }
 

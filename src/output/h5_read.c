@@ -248,6 +248,31 @@ int bk_h5_open_transitions(hid_t file, const char *path, hid_t *dset, hid_t *mem
     return BK_OK;
 }
 
+int bk_h5_each_transition(hid_t file, const char *path, bk_h5_transition_visit visit, void *user,
+                          hsize_t *count, bk_error *err)
+{
+    hid_t dset, mem;
+    int rc = bk_h5_open_transitions(file, path, &dset, &mem, count, err);
+    if (rc != BK_OK)
+        return rc;
+    bk_transition *buf = malloc(TRANSITION_BUFFER * sizeof *buf);
+    if (!buf)
+        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    for (hsize_t start = 0; rc == BK_OK && start < *count; start += TRANSITION_BUFFER) {
+        size_t n = *count - start < TRANSITION_BUFFER ? (size_t)(*count - start) : TRANSITION_BUFFER;
+        if (bk_h5_read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
+            rc = H5_DAMAGED(err, "%s: damaged: /transitions rows %llu..%llu cannot be read", path,
+                            (unsigned long long)start, (unsigned long long)(start + n - 1));
+            break;
+        }
+        for (size_t k = 0; rc == BK_OK && k < n; ++k)
+            rc = visit(&buf[k], (unsigned long long)(start + k), user, err);
+    }
+    free(buf);
+    CLOSE_IDS(0, mem, dset);
+    return rc;
+}
+
 int bk_h5_read_transitions(const char *path, bk_transition **rows, size_t *count,
                            bk_error *err)
 {

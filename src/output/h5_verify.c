@@ -118,52 +118,50 @@ static int mark_damaged(bk_error *err, const char *path, const char *fallback)
     return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: %s", path, reason);
 }
 
+typedef struct transition_check {
+    const verify_ctx *v;
+    double bound; /* s: no transition after this */
+    double prev;  /* s: the last row's time */
+} transition_check;
+
+static int check_transition(const bk_transition *t, unsigned long long row, void *user, bk_error *err)
+{
+    transition_check *c = user;
+    const verify_ctx *v = c->v;
+    const char *path = v->path;
+    int rc = BK_OK;
+    if (!isfinite(t->t) || !isfinite(t->x) || !isfinite(t->v) || !isfinite(t->force))
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu has a value "
+                     "that is not finite (t %g, x %g, v %g, force %g)", path, row, t->t,
+                     t->x, t->v, t->force);
+    else if (t->t < c->prev)
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions is not in time order "
+                     "at row %llu (t = %.17g s after %.17g s)", path, row, t->t, c->prev);
+    else if (t->t > c->bound)
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu is at "
+                     "t = %.17g s, after the %s (%.17g s)", path, row, t->t,
+                     v->complete ? "end of the run" : "run's t_end",
+                     v->complete ? v->t_reached : v->t_end);
+    else if (t->block < 0 || t->block >= v->n_blocks)
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu names block "
+                     "%d, outside 0..%lld", path, row, (int)t->block, v->n_blocks - 1);
+    else if (!valid_mode(t->from) || !valid_mode(t->to))
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu goes from "
+                     "mode %d to %d; modes are stick 0, slip+ 1, slip- -1", path, row,
+                     (int)t->from, (int)t->to);
+    c->prev = t->t;
+    return rc;
+}
+
 static int scan_transitions(hid_t file, const verify_ctx *v, bk_error *err)
 {
-    const char *path = v->path;
-    hid_t dset, mem;
-    hsize_t count;
-    if (bk_h5_open_transitions(file, path, &dset, &mem, &count, err) != BK_OK)
-        return mark_damaged(err, path, "/transitions cannot be read");
     double bound = v->complete ? v->t_reached : v->t_end;
-    bound += 1e-9 * fabs(bound);
-    bk_transition *buf = malloc(TRANSITION_BUFFER * sizeof *buf);
-    int rc = buf ? BK_OK : BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
-    double prev = 0.0;
-    for (hsize_t start = 0; rc == BK_OK && start < count; start += TRANSITION_BUFFER) {
-        size_t n = count - start < TRANSITION_BUFFER ? (size_t)(count - start) : TRANSITION_BUFFER;
-        if (bk_h5_read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
-            rc = H5_DAMAGED(err, "%s: damaged: /transitions rows %llu..%llu cannot be read", path,
-                            (unsigned long long)start, (unsigned long long)(start + n - 1));
-            break;
-        }
-        for (size_t k = 0; rc == BK_OK && k < n; ++k) {
-            const bk_transition *t = &buf[k];
-            unsigned long long row = (unsigned long long)(start + k);
-            if (!isfinite(t->t) || !isfinite(t->x) || !isfinite(t->v) || !isfinite(t->force))
-                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu has a value "
-                             "that is not finite (t %g, x %g, v %g, force %g)", path, row, t->t,
-                             t->x, t->v, t->force);
-            else if (t->t < prev)
-                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions is not in time order "
-                             "at row %llu (t = %.17g s after %.17g s)", path, row, t->t, prev);
-            else if (t->t > bound)
-                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu is at "
-                             "t = %.17g s, after the %s (%.17g s)", path, row, t->t,
-                             v->complete ? "end of the run" : "run's t_end",
-                             v->complete ? v->t_reached : v->t_end);
-            else if (t->block < 0 || t->block >= v->n_blocks)
-                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu names block "
-                             "%d, outside 0..%lld", path, row, (int)t->block, v->n_blocks - 1);
-            else if (!valid_mode(t->from) || !valid_mode(t->to))
-                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /transitions row %llu goes from "
-                             "mode %d to %d; modes are stick 0, slip+ 1, slip- -1", path, row,
-                             (int)t->from, (int)t->to);
-            prev = t->t;
-        }
-    }
-    free(buf);
-    CLOSE_IDS(0, mem, dset);
+    transition_check check = {v, bound + 1e-9 * fabs(bound), 0.0};
+    hsize_t count = 0;
+    int rc = bk_h5_each_transition(file, v->path, check_transition, &check, &count, err);
+    /* A table that does not open is damage too (the file says it wrote one). */
+    if (rc == BK_ERR_HDF5)
+        return mark_damaged(err, v->path, "/transitions cannot be read");
     return rc;
 }
 
