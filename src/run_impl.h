@@ -1,6 +1,6 @@
 /* Internal: the run loop's state, shared by run.c (set-up and the scheduler), run_islands.c
- * (the partition into islands and quiet blocks, island steps and events) and run_output.c
- * (rows, transitions, energies, checkpoints). */
+ * (the partition into islands and quiet blocks, island steps and events), run_quiet.c (when a
+ * quiet block breaks away) and run_output.c (rows, transitions, energies, checkpoints). */
 #ifndef BKSIM_RUN_IMPL_H
 #define BKSIM_RUN_IMPL_H
 
@@ -127,6 +127,9 @@ int bk_run_apply_event(run_ctx *ctx, double t, size_t i, bk_mode_event event);
 int bk_run_island_event(run_ctx *ctx, size_t id);
 /* Every quiet block failing at t (to rounding) breaks away. */
 int bk_run_quiet_failures(run_ctx *ctx, double t);
+/* run_quiet.c: block i (stuck, next to no slipping block) leaves the integrators at t; its
+ * breakaway time goes into the quiet queue. */
+void bk_run_make_quiet(run_ctx *ctx, size_t i, double t);
 /* Fill the chain's arrays with every island's state at t (interpolated, or the island's
  * own vector where it stands at t), and ctx->work and ctx->dissipation with the totals. */
 int bk_run_unpack_all(run_ctx *ctx, double t);

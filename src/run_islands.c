@@ -1,7 +1,7 @@
 /* The chain's partition into islands and quiet blocks (scene.h), and what happens to them:
  * an island steps with its own integrator and finds its next event; at an event only that
  * island (and a neighbour it may merge with) is rebuilt; a quiet block breaks away at a time
- * known in closed form, kept in a priority queue.  Nothing here loops over the chain except
+ * known in closed form (run_quiet.c), kept in a priority queue.  Nothing here loops over the chain except
  * bk_run_partition_all (start, checkpoints) and bk_run_unpack_all (output rows).
  *
  * Why the partition is safe: a quiet block's neighbours are stuck, so its applied force is
@@ -25,8 +25,6 @@
 /* Quiet blocks whose failure times agree to this many ulps fail at one instant (a uniform
  * chain's blocks all do). */
 #define SIMULTANEOUS_EPS (8.0 * DBL_EPSILON)
-/* Samples of a stateful block's threshold margin per doubling of the look-ahead. */
-#define AGING_SCAN_START (1.0 / 64.0)
 
 /* ---------------------------------------------------------------- bookkeeping --- */
 
@@ -275,121 +273,6 @@ int bk_run_unpack_all(run_ctx *ctx, double t)
     return BK_OK;
 }
 
-/* ------------------------------------------------------- quiet blocks' failures --- */
-
-/* The force on quiet block i at driver position D (its neighbours stuck, so fixed). */
-static double quiet_force(const run_ctx *ctx, size_t i, double driver_pos)
-{
-    return bk_model_applied_force(ctx->model, i, ctx->scene.x, driver_pos);
-}
-
-/* Time block i breaks away with a constant threshold, from the applied force's affine
- * dependence on the driver position; +inf if never. */
-static double coulomb_failure(const run_ctx *ctx, size_t i, double t, double threshold)
-{
-    const bk_model *model = ctx->model;
-    const bk_scene *scene = &ctx->scene;
-    double k = model->blocks[i].driver_stiffness;
-    double velocity = bk_driver_velocity(&model->driver, t);
-    if (k == 0.0 || velocity == 0.0)
-        return INFINITY;
-    double coupling = bk_model_coupling_force(model, i, scene->x);
-    /* The driver spring force rises with D when the driver advances, falls when it retreats;
-     * a tension-only spring can only pull, so a retreating driver never breaks it away
-     * unless the coupling alone does. */
-    double target_force = velocity > 0.0 ? threshold - coupling : -threshold - coupling;
-    if (velocity < 0.0 && model->spring == BK_SPRING_TENSION_ONLY && target_force < 0.0)
-        return INFINITY;
-    double target_position = scene->x[i] + target_force / k;
-    double here = bk_driver_position(&model->driver, t);
-    if ((target_position - here) * velocity <= 0.0)
-        return t;
-    return bk_driver_time_at(&model->driver, t, target_position);
-}
-
-typedef struct aging_margin {
-    const run_ctx *ctx;
-    size_t block;
-} aging_margin;
-
-/* Threshold minus |applied force| of a resting block at time t. */
-static double margin_at(double t, void *user)
-{
-    const aging_margin *m = user;
-    const run_ctx *ctx = m->ctx;
-    const bk_block *b = &ctx->model->blocks[m->block];
-    double state[BK_FRICTION_MAX_STATE];
-    bk_scene_state_at_rest(&ctx->scene, m->block, t, state);
-    double threshold = b->law->static_threshold(b->friction_params, ctx->scene.normal[m->block], state);
-    return threshold - fabs(quiet_force(ctx, m->block, bk_driver_position(&ctx->model->driver, t)));
-}
-
-/* The failure time of a resting block whose threshold ages (state at rest): the first zero
- * of the margin after t.  The margin is sampled at look-aheads doubling from a fraction of
- * the time the driver needs to load the spring by the threshold, then the crossing is
- * located by Brent.  Aging laws strengthen the contact concavely in time while the driver
- * loads it linearly, so the margin has one falling zero and sampling cannot step over it. */
-static double aging_failure(const run_ctx *ctx, size_t i, double t)
-{
-    aging_margin m = {ctx, i};
-    double g0 = margin_at(t, &m);
-    if (!(g0 > 0.0))
-        return t;
-    const bk_block *b = &ctx->model->blocks[i];
-    double speed = fabs(bk_driver_velocity(&ctx->model->driver, t));
-    if (b->driver_stiffness == 0.0 || speed == 0.0)
-        return INFINITY;
-    double span = g0 / (b->driver_stiffness * speed);
-    double lo = t, hi = t, horizon = ctx->t_end;
-    for (double ahead = AGING_SCAN_START * span;; ahead *= 2.0) {
-        lo = hi;
-        hi = t + ahead;
-        if (hi > horizon)
-            hi = horizon;
-        if (margin_at(hi, &m) <= 0.0)
-            break;
-        if (hi >= horizon)
-            return INFINITY;
-    }
-    gsl_function fn = {margin_at, &m};
-    gsl_root_fsolver *solver = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
-    if (!solver)
-        return lo;
-    if (gsl_root_fsolver_set(solver, &fn, lo, hi) != GSL_SUCCESS) {
-        gsl_root_fsolver_free(solver);
-        return hi;
-    }
-    for (int iter = 0; iter < 200; ++iter) {
-        if (gsl_root_fsolver_iterate(solver) != GSL_SUCCESS)
-            break;
-        double a = gsl_root_fsolver_x_lower(solver), c = gsl_root_fsolver_x_upper(solver);
-        if (gsl_root_test_interval(a, c, 0.0, 4.0 * DBL_EPSILON) == GSL_SUCCESS)
-            break;
-    }
-    /* The upper end is past the zero, as at a root an integrator reports. */
-    double failure = gsl_root_fsolver_x_upper(solver);
-    gsl_root_fsolver_free(solver);
-    return failure;
-}
-
-static double failure_time(const run_ctx *ctx, size_t i, double t)
-{
-    if (ctx->model->blocks[i].law->n_state == 0)
-        return coulomb_failure(ctx, i, t, bk_scene_static_threshold(&ctx->scene, i));
-    return aging_failure(ctx, i, t);
-}
-
-/* Block i (stuck, next to no slipping block) leaves the integrators at t. */
-static void make_quiet(run_ctx *ctx, size_t i, double t)
-{
-    bk_scene *scene = &ctx->scene;
-    scene->island_of[i] = BK_NO_ISLAND;
-    scene->slot[i] = BK_NO_SLOT;
-    scene->x_ref[i] = scene->x[i];
-    scene->v[i] = 0.0;
-    bk_heap_set(&ctx->quiet, i, failure_time(ctx, i, t));
-}
-
 /* --------------------------------------------------------------- the partition --- */
 
 static size_t wrap(const run_ctx *ctx, long j)
@@ -453,7 +336,7 @@ static int close_group(run_ctx *ctx, long group_lo, long group_hi, long *next_qu
         b = b > n - 1 ? n - 1 : b;
     }
     for (long q = *next_quiet; q < a; ++q)
-        make_quiet(ctx, wrap(ctx, q), t);
+        bk_run_make_quiet(ctx, wrap(ctx, q), t);
     *next_quiet = b + 1;
     return found_island(ctx, a, b, t);
 }
@@ -480,7 +363,7 @@ static int rebuild(run_ctx *ctx, long lo, long hi, int whole_ring, double t)
             if (any_slipping)
                 return found_island(ctx, 0, n - 1, t);
             for (long j = 0; j < n; ++j)
-                make_quiet(ctx, (size_t)j, t);
+                bk_run_make_quiet(ctx, (size_t)j, t);
             return BK_OK;
         }
         lo = cut;
@@ -506,7 +389,7 @@ static int rebuild(run_ctx *ctx, long lo, long hi, int whole_ring, double t)
     if (rc == BK_OK && group_hi >= group_lo)
         rc = close_group(ctx, group_lo, group_hi, &next_quiet, t);
     for (long q = next_quiet; rc == BK_OK && q <= hi; ++q)
-        make_quiet(ctx, wrap(ctx, q), t);
+        bk_run_make_quiet(ctx, wrap(ctx, q), t);
     return rc;
 }
 

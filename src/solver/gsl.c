@@ -47,6 +47,7 @@
 #include <gsl/gsl_roots.h>
 
 #include "bksim/solver.h"
+#include "gsl_shared.h"
 
 typedef enum { DENSE_RESTEP, DENSE_HERMITE } dense_kind;
 
@@ -74,7 +75,7 @@ typedef struct gsl_backend {
      * control through a driver, so each instance owns one; the RK pairs carry nothing but
      * evolve's dydt_out, which step() refills from f_lo, so they borrow shared ones. */
     gsl_odeiv2_driver *driver;  /* msbdf: owns stepper, control and evolve */
-    struct shared_rk *shared;   /* RK: stepper, probe, evolve and control, borrowed */
+    bk_gsl_shared *shared;     /* RK: stepper, probe, evolve and control, borrowed */
     gsl_odeiv2_step *stepper;
     gsl_odeiv2_step *probe;     /* second stepper for DENSE_RESTEP */
     gsl_odeiv2_evolve *evolve;
@@ -159,143 +160,6 @@ static int eval_roots(gsl_backend *b, double t, const double *y, double *g)
         if (!isfinite(g[i]))
             return -1;
     return 0;
-}
-
-/* --- step-size control and shared RK objects ------------------------------------------- */
-
-/* GSL's scaled control (D_i = eps_abs scale_i + eps_rel |y_i|, with a_y = 1, a_dydt = 0)
- * reading its weights through a pointer instead of a copy made at allocation, so that one
- * control serves islands whose layouts differ.  hadjust is GSL's heuristic as documented
- * (decrease when the error exceeds D by 10 %, by S / r^(1/q) but at most 5 times;
- * increase when below half, by S / r^(1/(q+1)) at most 4.9 times; S = 0.9), evaluated
- * in GSL's order so that steps are bit-identical to gsl_odeiv2_control_scaled's. */
-typedef struct scaled_control {
-    double eps_abs, eps_rel;
-    const double *scale;
-} scaled_control;
-
-static void *control_alloc(void)
-{
-    return calloc(1, sizeof(scaled_control));
-}
-
-static int control_init(void *state, double eps_abs, double eps_rel, double a_y, double a_dydt)
-{
-    (void)a_y;
-    (void)a_dydt;
-    scaled_control *c = state;
-    c->eps_abs = eps_abs;
-    c->eps_rel = eps_rel;
-    return GSL_SUCCESS;
-}
-
-static int control_hadjust(void *state, size_t dim, unsigned int ord, const double y[],
-                           const double yerr[], const double yp[], double *h)
-{
-    (void)yp;
-    const scaled_control *c = state;
-    const double S = 0.9, h_old = *h;
-    double rmax = DBL_MIN;
-    for (size_t i = 0; i < dim; ++i) {
-        double d0 = c->eps_rel * fabs(y[i]) + c->eps_abs * c->scale[i];
-        double r = fabs(yerr[i]) / fabs(d0);
-        rmax = r > rmax ? r : rmax;
-    }
-    if (rmax > 1.1) {
-        double r = S / pow(rmax, 1.0 / ord);
-        *h = (r < 0.2 ? 0.2 : r) * h_old;
-        return GSL_ODEIV_HADJ_DEC;
-    }
-    if (rmax < 0.5) {
-        double r = S / pow(rmax, 1.0 / (ord + 1.0));
-        r = r > 4.9 ? 4.9 : r;
-        *h = (r < 1.0 ? 1.0 : r) * h_old;
-        return GSL_ODEIV_HADJ_INC;
-    }
-    return GSL_ODEIV_HADJ_NIL;
-}
-
-static int control_errlevel(void *state, double y, double dydt, double h, size_t ind, double *errlev)
-{
-    (void)dydt;
-    (void)h;
-    const scaled_control *c = state;
-    *errlev = c->eps_rel * fabs(y) + c->eps_abs * c->scale[ind];
-    return *errlev > 0.0 ? GSL_SUCCESS : GSL_ESANITY;
-}
-
-static int control_set_driver(void *state, const gsl_odeiv2_driver *d)
-{
-    (void)state;
-    (void)d;
-    return GSL_SUCCESS;
-}
-
-static const gsl_odeiv2_control_type scaled_control_type = {
-    "bksim scaled", control_alloc, control_init, control_hadjust, control_errlevel,
-    control_set_driver, free};
-
-/* The RK objects of one size, shared by this thread's instances: a long chain runs
- * thousands of islands in turn, and objects of their own (16 n doubles of stages and
- * copies in a dozen allocations) would be cold at every turn.  Sharing is exact: an RK
- * step reads nothing left by the last one except evolve's dydt_out, refilled per step.
- * Reference-counted; an instance stays in the thread that made it. */
-typedef struct shared_rk {
-    const gsl_odeiv2_step_type *type;
-    size_t n, users;
-    gsl_odeiv2_step *stepper, *probe;
-    gsl_odeiv2_evolve *evolve;
-    gsl_odeiv2_control *control;
-    struct shared_rk *next; /* same bucket */
-} shared_rk;
-
-#define SHARED_BUCKETS 64
-static _Thread_local shared_rk *shared_table[SHARED_BUCKETS];
-
-static void shared_free(shared_rk *s)
-{
-    if (s->stepper)
-        gsl_odeiv2_step_free(s->stepper);
-    if (s->probe)
-        gsl_odeiv2_step_free(s->probe);
-    if (s->evolve)
-        gsl_odeiv2_evolve_free(s->evolve);
-    if (s->control)
-        gsl_odeiv2_control_free(s->control);
-    free(s);
-}
-
-static shared_rk *shared_acquire(const gsl_odeiv2_step_type *type, size_t n)
-{
-    shared_rk **bucket = &shared_table[n % SHARED_BUCKETS];
-    for (shared_rk *s = *bucket; s; s = s->next)
-        if (s->type == type && s->n == n) {
-            s->users++;
-            return s;
-        }
-    shared_rk *s = calloc(1, sizeof *s);
-    if (!s)
-        return NULL;
-    *s = (shared_rk){type, n, 1, gsl_odeiv2_step_alloc(type, n), gsl_odeiv2_step_alloc(type, n),
-                     gsl_odeiv2_evolve_alloc(n), gsl_odeiv2_control_alloc(&scaled_control_type), *bucket};
-    if (!s->stepper || !s->probe || !s->evolve || !s->control) {
-        shared_free(s);
-        return NULL;
-    }
-    *bucket = s;
-    return s;
-}
-
-static void shared_release(shared_rk *s)
-{
-    if (!s || --s->users > 0)
-        return;
-    for (shared_rk **link = &shared_table[s->n % SHARED_BUCKETS]; *link; link = &(*link)->next)
-        if (*link == s) {
-            *link = s->next;
-            break;
-        }
-    shared_free(s);
 }
 
 /* --- dense output ---------------------------------------------------------------------- */
@@ -492,7 +356,7 @@ static void free_steppers(gsl_backend *b)
 {
     if (b->driver)
         gsl_odeiv2_driver_free(b->driver);
-    shared_release(b->shared);
+    bk_gsl_shared_release(b->shared);
     b->driver = NULL;
     b->shared = NULL;
     b->stepper = b->probe = NULL;
@@ -649,7 +513,7 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     if (b->variant->dense == DENSE_RESTEP) {
         if (!b->shared || b->shared->n != n) {
             free_steppers(b);
-            b->shared = shared_acquire(*b->variant->type, n);
+            b->shared = bk_gsl_shared_acquire(*b->variant->type, n);
             if (b->shared) {
                 b->stepper = b->shared->stepper;
                 b->probe = b->shared->probe;
@@ -767,10 +631,8 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
     double h_in = h >= remaining ? 2.0 * remaining : h;
     gsl_odeiv2_evolve *e = b->evolve;
     if (b->shared) {
-        scaled_control *c = b->control->state;
-        c->eps_abs = b->variant->tolerance_factor * b->eps_abs;
-        c->eps_rel = b->variant->tolerance_factor * b->options.rtol;
-        c->scale = b->scale;
+        bk_gsl_control_weights(b->control, b->variant->tolerance_factor * b->eps_abs,
+                               b->variant->tolerance_factor * b->options.rtol, b->scale);
         /* What evolve would reuse as the step's initial derivative: f at its start. */
         memcpy(e->dydt_out, b->f_lo, n * sizeof *y);
         e->count = 1;

@@ -1,0 +1,96 @@
+/* Internal to the exact stepper (exact.c: memory, start, stepping and events;
+ * exact_matrices.c: reading K, P, Q and the forcing from the problem; exact_modes.c: the
+ * clusters, their modes and the closed-form state).  exact.c's header says what it computes. */
+#ifndef BKSIM_EXACT_IMPL_H
+#define BKSIM_EXACT_IMPL_H
+
+#include <float.h>
+#include <stddef.h>
+
+#include <gsl/gsl_eigen.h>
+#include <gsl/gsl_roots.h>
+
+#include "bksim/solver.h"
+
+#define PI 3.14159265358979323846
+#define SAMPLES_PER_PERIOD 16.0
+/* An eigenvalue of S below this fraction of its cluster's largest is rounding: the mode is
+ * free. */
+#define ZERO_MODE (128.0 * DBL_EPSILON)
+/* Relative size of a structural entry that must vanish (velocity dependence etc.). */
+#define STRUCTURE_TOL 1e-9
+#define BRENT_MAX_ITER 200
+#define MAX_HALVINGS 16
+#define USE_INTEGRATOR "; use method = auto (it picks an integrator for such scenes), gsl_rk8pd or cvode_bdf"
+/* Stiffness coupling K[row][col] (s^-2) between pairs, one Jacobian entry or probe column;
+ * entries for one (row, col) add up. */
+typedef struct coupling {
+    size_t row, col;
+    double value;
+} coupling;
+
+/* A problem the Jacobian shows the stepper cannot solve (first offending entry). */
+enum { JACOBIAN_OK, JACOBIAN_NOMEM, JACOBIAN_RANGE, JACOBIAN_VELOCITY, JACOBIAN_QUADRATURE };
+
+typedef struct exact_backend {
+    bk_solver_options options;
+    bk_ode_problem problem;
+    size_t n, p, m, n_roots;    /* state size, pairs, quadratures, root functions */
+    double t0, t_stop, h;       /* start, stop, sampling step */
+    double t_now;               /* time reached by the last step */
+    double t_lo, t_hi;          /* the last step */
+
+    /* One arena for everything sized by p, m and n; regrown only when it must. */
+    double *arena;
+    size_t arena_cap;
+    double *y0;                 /* n: the starting state */
+    double *f0, *scratch, *probe, *scale, *delta, *predicted; /* n each: rates at the start,
+                                                                 work space */
+    double *sqrt_mass;          /* p */
+    double *omega2, *omega;     /* p, by mode (a cluster's modes follow its first's) */
+    double *c, *g, *d;          /* p: modal initial velocity, forcing, forcing rate */
+    double *eta, *deta, *ieta, *idv; /* p: eta, eta' - c, their integrals */
+    double *accel0, *accel_rate;/* p: accelerations at t0 and their time rate */
+    double *row_sum, *row_scale;/* p: sum and largest magnitude of each row of K */
+    double *P, *Q;              /* m*p: quadrature rates' position and velocity coefficients */
+    double *P_modal, *Q_modal;  /* m*p: the same in modal coordinates */
+    double *qdot0, *q_rate;     /* m: quadrature rates at t0 and their time rate */
+
+    /* Clusters: cluster k holds pairs members[first[k] .. first[k + 1]) in ascending order,
+     * its modes are first[k] .. first[k + 1], its matrices start at offset[k]. */
+    size_t *indices;
+    size_t indices_cap;
+    size_t *members, *first, *offset, *cluster_of, *local, *parent; /* p (+1) each */
+    size_t *uniform;            /* per cluster: it moves as one (see the top of the file) */
+    size_t n_clusters;
+    coupling *couplings;        /* K's entries */
+    size_t n_couplings, couplings_cap;
+    double *matrices;           /* S of each cluster (in place), then T = M^(-1/2) U of each,
+                                   then one cluster's work copy */
+    size_t matrices_cap;
+    double *S, *T, *work;
+    gsl_eigen_symmv_workspace *eigen;
+    int jacobian_status;
+    size_t bad_row, bad_col;
+
+    /* Root functions. */
+    size_t roots_cap;
+    int *direction;
+    signed char *sign;          /* last non-zero sign seen; 0 = inactive (zero so far) */
+    int *found;
+    double *g_hi, *g_try, *root_t;
+    double g_try_time;          /* when g_try was evaluated (NAN: not since the start) */
+    gsl_root_fsolver *brent;
+
+    bk_solver_counters counters;
+} exact_backend;
+
+
+/* exact_matrices.c: the affine forcing at t0 and K, P, Q (from the Jacobian when the problem
+ * has one, else one probe per column); the right-hand side checked for finite values. */
+int bk_exact_read_problem(exact_backend *eb, bk_error *err);
+/* exact_modes.c: clusters and their modes (after bk_exact_read_problem); the exact state at t. */
+int bk_exact_modes(exact_backend *eb, bk_error *err);
+void bk_exact_state(exact_backend *eb, double t, double *y);
+
+#endif
