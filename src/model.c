@@ -2,9 +2,7 @@
 #include "bksim/model.h"
 
 #include <math.h>
-#include <stdint.h>
 #include <stdlib.h>
-#include <string.h>
 
 bk_model *bk_model_create(size_t n_blocks)
 {
@@ -13,12 +11,7 @@ bk_model *bk_model_create(size_t n_blocks)
     bk_model *model = calloc(1, sizeof *model);
     if (!model)
         return NULL;
-    size_t bytes = n_blocks * sizeof *model->blocks;
-    model->blocks = n_blocks <= SIZE_MAX / sizeof *model->blocks
-                        ? aligned_alloc(_Alignof(bk_block), bytes)
-                        : NULL;
-    if (model->blocks)
-        memset(model->blocks, 0, bytes);
+    model->blocks = calloc(n_blocks, sizeof *model->blocks);
     if (!model->blocks) {
         free(model);
         return NULL;

@@ -29,11 +29,8 @@ typedef enum bk_spring {
     BK_SPRING_TENSION_ONLY = 1 /* pulls only: zero force when the block is ahead of the driver */
 } bk_spring;
 
-/* Aligned to a cache line: the fields a right-hand side reads (mass, stiffness, law, the
- * first friction parameters) then share one line per block, which matters when a long
- * chain's islands take turns. */
 typedef struct bk_block {
-    _Alignas(64) double mass; /* kg, > 0 */
+    double mass;             /* kg, > 0 */
     double driver_stiffness; /* N/m, >= 0 */
     double normal_force;     /* N, > 0; default mass * gravity */
     double x_init;           /* m, initial displacement; default 0 */
