@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "capacity.h"
 #include "scene.h"
 
 size_t bk_island_max_y(const bk_scene *scene, size_t len)
@@ -38,7 +39,7 @@ size_t bk_island_y_length(const bk_scene *scene, size_t start, size_t len)
 
 int bk_island_reserve(bk_island *island, size_t len)
 {
-    if (len <= island->capacity)
+    if (bk_capacity_fits(len, island->capacity))
         return 0;
     size_t max_y = bk_island_max_y(island->scene, len);
     size_t R = island->scene->roots_per_block;

@@ -17,6 +17,7 @@ typedef struct run_island {
     bk_island island;        /* layout and ODE; the problem's user data */
     bk_ode_problem problem;
     void *solver;            /* an instance of the back-end, from the pool */
+    size_t solver_peak;      /* the largest problem that instance has served */
     double *y, *y_probe, *atol;
     int *found;              /* root_info of the pending event */
     size_t capacity_y, capacity_roots;
@@ -51,12 +52,15 @@ typedef struct run_ctx {
     size_t n_free;
     size_t live_islands;
     bk_heap island_queue;    /* live islands by their pending event's time, else t_reached */
-    /* Back-end instances: every one ever made (for the counters), the idle ones reused. */
-    void **solvers;
-    size_t n_solvers, solvers_capacity;
+    /* Idle back-end instances, reused; the pool holds small ones only, within a budget in
+     * proportion to the chain, so memory follows the chain and not the run's history. */
     void **idle;
     size_t *idle_len;        /* the problem size each idle instance last served */
-    size_t n_idle;
+    size_t *idle_peak;       /* the largest problem each one served: what it holds */
+    size_t n_idle, idle_capacity;
+    size_t idle_held;        /* the sum of idle_peak */
+    size_t idle_budget;
+    bk_solver_counters retired; /* counters of the instances destroyed */
     /* Quiet stuck blocks by failure time (closed form, no integrator). */
     bk_heap quiet;
     size_t *batch;           /* blocks failing at one instant, scratch */

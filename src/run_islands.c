@@ -20,11 +20,21 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_roots.h>
 
+#include "capacity.h"
 #include "run_impl.h"
 
 /* Quiet blocks whose failure times agree to this many ulps fail at one instant (a uniform
  * chain's blocks all do). */
 #define SIMULTANEOUS_EPS (8.0 * DBL_EPSILON)
+
+/* Idle instances searched for one that last served a problem of the same size: a back-end
+ * reuses its objects when the size repeats (allocating anew at every restart dominated on
+ * long chains). */
+#define IDLE_MATCH_SPAN 32
+/* Unknowns above which an instance is destroyed when its island dissolves: making one for
+ * a large island costs little next to restarting it, and kept ones would each hold the
+ * largest island they ever served. */
+#define POOL_LARGEST_Y 64
 
 /* ---------------------------------------------------------------- bookkeeping --- */
 
@@ -33,6 +43,10 @@ int bk_run_islands_init(run_ctx *ctx)
     size_t n = ctx->scene.n;
     if (bk_heap_init(&ctx->quiet, n) != 0 || bk_heap_init(&ctx->island_queue, 16) != 0)
         return -1;
+    /* Idle instances together hold no more than one instance for the whole chain. */
+    ctx->idle_budget = bk_island_max_y(&ctx->scene, n);
+    if (ctx->idle_budget < 16 * POOL_LARGEST_Y)
+        ctx->idle_budget = 16 * POOL_LARGEST_Y;
     ctx->batch = malloc(n * sizeof *ctx->batch);
     return ctx->batch ? 0 : -1;
 }
@@ -41,16 +55,18 @@ void bk_run_islands_free(run_ctx *ctx)
 {
     for (size_t id = 0; id < ctx->islands_used; ++id) {
         run_island *isl = ctx->islands[id];
+        if (isl->solver)
+            ctx->backend->destroy(isl->solver);
         bk_island_free(&isl->island);
         free(isl->y);
         free(isl->found);
         free(isl);
     }
-    for (size_t k = 0; k < ctx->n_solvers; ++k)
-        ctx->backend->destroy(ctx->solvers[k]);
-    free(ctx->solvers);
+    for (size_t k = 0; k < ctx->n_idle; ++k)
+        ctx->backend->destroy(ctx->idle[k]);
     free(ctx->idle);
     free(ctx->idle_len);
+    free(ctx->idle_peak);
     free(ctx->islands);
     free(ctx->free_ids);
     free(ctx->batch);
@@ -58,17 +74,27 @@ void bk_run_islands_free(run_ctx *ctx)
     bk_heap_free(&ctx->island_queue);
 }
 
+static void add_counters(bk_solver_counters *total, const bk_solver_counters *c)
+{
+    total->steps += c->steps;
+    total->rhs_evals += c->rhs_evals;
+    total->root_evals += c->root_evals;
+    total->err_test_fails += c->err_test_fails;
+    total->nonlin_iters += c->nonlin_iters;
+}
+
 void bk_run_solver_counters(const run_ctx *ctx, bk_solver_counters *total)
 {
-    memset(total, 0, sizeof *total);
-    for (size_t k = 0; k < ctx->n_solvers; ++k) {
-        bk_solver_counters c;
-        ctx->backend->counters(ctx->solvers[k], &c);
-        total->steps += c.steps;
-        total->rhs_evals += c.rhs_evals;
-        total->root_evals += c.root_evals;
-        total->err_test_fails += c.err_test_fails;
-        total->nonlin_iters += c.nonlin_iters;
+    *total = ctx->retired;
+    bk_solver_counters c;
+    for (size_t id = 0; id < ctx->islands_used; ++id)
+        if (ctx->islands[id]->solver) {
+            ctx->backend->counters(ctx->islands[id]->solver, &c);
+            add_counters(total, &c);
+        }
+    for (size_t k = 0; k < ctx->n_idle; ++k) {
+        ctx->backend->counters(ctx->idle[k], &c);
+        add_counters(total, &c);
     }
 }
 
@@ -77,14 +103,8 @@ static double island_key(const run_island *isl)
     return isl->pending ? isl->t_event : isl->t_reached;
 }
 
-/* Idle instances searched for one that last served a problem of the same size: a back-end
- * reuses its objects when the size repeats (allocating anew at every restart dominated on
- * long chains). */
-#define IDLE_MATCH_SPAN 32
-
-/* A back-end instance for a problem of n_y unknowns: an idle one, else a new one (kept for
- * its counters). */
-static int take_solver(run_ctx *ctx, size_t n_y, void **solver)
+/* A back-end instance for a problem of n_y unknowns: an idle one, else a new one. */
+static int take_solver(run_ctx *ctx, size_t n_y, run_island *isl)
 {
     if (ctx->n_idle > 0) {
         size_t pick = ctx->n_idle - 1;
@@ -93,33 +113,57 @@ static int take_solver(run_ctx *ctx, size_t n_y, void **solver)
                 pick = ctx->n_idle - 1 - k;
                 break;
             }
-        *solver = ctx->idle[pick];
-        ctx->idle[pick] = ctx->idle[ctx->n_idle - 1];
-        ctx->idle_len[pick] = ctx->idle_len[ctx->n_idle - 1];
-        ctx->n_idle--;
+        isl->solver = ctx->idle[pick];
+        isl->solver_peak = ctx->idle_peak[pick];
+        ctx->idle_held -= ctx->idle_peak[pick];
+        size_t last = --ctx->n_idle;
+        ctx->idle[pick] = ctx->idle[last];
+        ctx->idle_len[pick] = ctx->idle_len[last];
+        ctx->idle_peak[pick] = ctx->idle_peak[last];
         return BK_OK;
     }
-    if (ctx->n_solvers == ctx->solvers_capacity) {
-        size_t cap = ctx->solvers_capacity ? 2 * ctx->solvers_capacity : 8;
-        void **all = realloc(ctx->solvers, cap * sizeof *all);
-        if (!all)
-            return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for solver instances");
-        ctx->solvers = all;
-        void **idle = realloc(ctx->idle, cap * sizeof *idle);
-        if (!idle)
-            return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for solver instances");
-        ctx->idle = idle;
-        size_t *idle_len = realloc(ctx->idle_len, cap * sizeof *idle_len);
-        if (!idle_len)
-            return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for solver instances");
-        ctx->idle_len = idle_len;
-        ctx->solvers_capacity = cap;
+    isl->solver_peak = 0;
+    return ctx->backend->create(&isl->solver, &ctx->options, ctx->err);
+}
+
+static int grow_idle(run_ctx *ctx)
+{
+    size_t cap = ctx->idle_capacity ? 2 * ctx->idle_capacity : 16;
+    void **idle = realloc(ctx->idle, cap * sizeof *idle);
+    if (!idle)
+        return -1;
+    ctx->idle = idle;
+    size_t *len = realloc(ctx->idle_len, cap * sizeof *len);
+    if (!len)
+        return -1;
+    ctx->idle_len = len;
+    size_t *peak = realloc(ctx->idle_peak, cap * sizeof *peak);
+    if (!peak)
+        return -1;
+    ctx->idle_peak = peak;
+    ctx->idle_capacity = cap;
+    return 0;
+}
+
+/* The instance of a dissolving island back to the pool, or destroyed (its counters kept)
+ * when it is large or the pool is full. */
+static void give_back_solver(run_ctx *ctx, run_island *isl)
+{
+    void *solver = isl->solver;
+    size_t peak = isl->solver_peak;
+    isl->solver = NULL;
+    if (peak <= POOL_LARGEST_Y && ctx->idle_held + peak <= ctx->idle_budget &&
+        (ctx->n_idle < ctx->idle_capacity || grow_idle(ctx) == 0)) {
+        ctx->idle[ctx->n_idle] = solver;
+        ctx->idle_len[ctx->n_idle] = isl->island.n_y;
+        ctx->idle_peak[ctx->n_idle++] = peak;
+        ctx->idle_held += peak;
+        return;
     }
-    int rc = ctx->backend->create(solver, &ctx->options, ctx->err);
-    if (rc != BK_OK)
-        return rc;
-    ctx->solvers[ctx->n_solvers++] = *solver;
-    return BK_OK;
+    bk_solver_counters c;
+    ctx->backend->counters(solver, &c);
+    add_counters(&ctx->retired, &c);
+    ctx->backend->destroy(solver);
 }
 
 /* A free island id with its arrays (kept from an earlier island when there is one). */
@@ -150,7 +194,7 @@ static int new_island(run_ctx *ctx, size_t n_y, size_t *id)
         isl->island.id = *id;
     }
     run_island *isl = ctx->islands[*id];
-    int rc = take_solver(ctx, n_y, &isl->solver);
+    int rc = take_solver(ctx, n_y, isl);
     if (rc != BK_OK) {
         ctx->free_ids[ctx->n_free++] = *id;
         return rc;
@@ -164,9 +208,16 @@ static void release_island(run_ctx *ctx, size_t id)
 {
     run_island *isl = ctx->islands[id];
     bk_heap_remove(&ctx->island_queue, id);
-    ctx->idle_len[ctx->n_idle] = isl->island.n_y;
-    ctx->idle[ctx->n_idle++] = isl->solver;
-    isl->solver = NULL;
+    give_back_solver(ctx, isl);
+    if (isl->capacity_y > POOL_LARGEST_Y) {
+        /* A dissolved large island's arrays go too, for the reason large instances do. */
+        bk_island_free(&isl->island);
+        free(isl->y);
+        free(isl->found);
+        isl->y = isl->y_probe = isl->atol = NULL;
+        isl->found = NULL;
+        isl->capacity_y = isl->capacity_roots = 0;
+    }
     isl->live = 0;
     isl->pending = 0;
     ctx->live_islands--;
@@ -179,7 +230,7 @@ static int reserve_vectors(run_ctx *ctx, run_island *isl, size_t len)
     size_t n_roots = ctx->scene.roots_per_block * len;
     if (bk_island_reserve(&isl->island, len) != 0)
         return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for an island of %zu blocks", len);
-    if (n_y > isl->capacity_y) {
+    if (!bk_capacity_fits(n_y, isl->capacity_y)) {
         /* One block: the island's vectors are touched together at every step. */
         double *block = realloc(isl->y, 3 * n_y * sizeof *block);
         if (!block)
@@ -189,7 +240,7 @@ static int reserve_vectors(run_ctx *ctx, run_island *isl, size_t len)
         isl->atol = block + 2 * n_y;
         isl->capacity_y = n_y;
     }
-    if (n_roots > isl->capacity_roots) {
+    if (n_roots > 0 && !bk_capacity_fits(n_roots, isl->capacity_roots)) {
         int *found = realloc(isl->found, n_roots * sizeof *found);
         if (!found)
             return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for an island of %zu blocks", len);
@@ -228,6 +279,8 @@ static int start_island(run_ctx *ctx, size_t id, double t)
         .affine = island->affine,
         .differential_id = ctx->scene.full_layout ? island->differential_id : NULL,
     };
+    if (island->n_y > isl->solver_peak)
+        isl->solver_peak = island->n_y;
     rc = ctx->backend->start(isl->solver, &isl->problem, t, isl->y, isl->atol, island->n_y,
                              bk_run_stop_time(ctx), ctx->err);
     if (rc != BK_OK)

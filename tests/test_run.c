@@ -513,6 +513,44 @@ static void test_distant_groups_independent(void **state)
     }
 }
 
+/* A uniform 40-block chain slides as one island of 82 unknowns, too large to be kept idle:
+ * its back-end instance is destroyed when the chain sticks and a new one made at the next
+ * slip.  The run's counters still add up every instance's work: four times the cycles make
+ * about four times the steps (counting only the instances kept would count none). */
+static void test_counters_outlive_instances(void **state)
+{
+    (void)state;
+    const char *methods[] = {"exact", "gsl_rk8pd"};
+    for (size_t m = 0; m < sizeof methods / sizeof *methods; ++m) {
+        long steps[2], starts[2];
+        const double t_end[2] = {1.0, 2.6}; /* first slip at 0.59 s, then one every 0.2 s */
+        for (size_t k = 0; k < 2; ++k) {
+            scene_spec spec = {.n = 40, .mass = 1.0, .stiffness = 1e4, .coupling = 2e4,
+                               .mu_s = 0.6, .mu_d = 0.5, .velocity = 1e-3, .t_end = t_end[k],
+                               .rtol = 1e-8, .interval = 0.0, .spring = BK_SPRING_LINEAR,
+                               .boundary = BK_BOUNDARY_FREE, .method = methods[m],
+                               .detect_extrema = 1, .max_per_instant = 100};
+            bk_config *c = scene_config(&spec);
+            bk_run_stats stats;
+            bk_error err = {0};
+            recorder r = {0};
+            int rc = run_recorded(c, &r, &stats, &err);
+            recorder_free(&r);
+            bk_config_free(c);
+            if (rc != BK_OK)
+                fail_msg("%s: %s", methods[m], err.message);
+            steps[k] = stats.steps;
+            starts[k] = stats.integrator_starts;
+        }
+        print_message("%s: %ld and %ld starts, %ld and %ld steps\n", methods[m], starts[0],
+                      starts[1], steps[0], steps[1]);
+        assert_true(steps[0] >= 5 * starts[0]); /* a slip takes many steps */
+        assert_true(starts[1] >= 3 * starts[0]);
+        assert_true(steps[1] >= 3 * steps[0]);
+        assert_true(steps[1] <= 5 * steps[0]);
+    }
+}
+
 /* [output] max_bytes counts everything written: full event rows on a 20-block chain pass
  * the limit that the transitions table alone stays under. */
 static void test_output_limit_counts_event_rows(void **state)
@@ -611,6 +649,7 @@ int main(void)
         cmocka_unit_test(test_per_block_laws),
         cmocka_unit_test(test_auto_method),
         cmocka_unit_test(test_distant_groups_independent),
+        cmocka_unit_test(test_counters_outlive_instances),
         cmocka_unit_test(test_output_limit_counts_event_rows),
         cmocka_unit_test(test_aging_breakaway),
     };

@@ -67,10 +67,103 @@
 
 /* --- memory ----------------------------------------------------------------------------- */
 
+static _Thread_local exact_shared *thread_shared;
+
+/* buf if it holds need elements of size bytes, else a buffer that does in its place
+ * (contents dropped); NULL when out of memory (buf kept). */
+static void *large_enough(void *buf, size_t *cap, size_t need, size_t size)
+{
+    if (need <= *cap)
+        return buf;
+    void *larger = malloc(need * size);
+    if (!larger)
+        return NULL;
+    free(buf);
+    *cap = need;
+    return larger;
+}
+
+static void shared_release(exact_shared *s)
+{
+    if (!s || --s->users > 0)
+        return;
+    gsl_root_fsolver_free(s->brent);
+    free(s->start);
+    free(s->modes);
+    free(s->indices);
+    free(s->couplings);
+    free(s);
+    thread_shared = NULL;
+}
+
+static exact_shared *shared_acquire(void)
+{
+    exact_shared *s = thread_shared;
+    if (!s) {
+        s = calloc(1, sizeof *s);
+        if (!s)
+            return NULL;
+        s->brent = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
+        if (!s->brent) {
+            free(s);
+            return NULL;
+        }
+        thread_shared = s;
+    }
+    s->users++;
+    return s;
+}
+
+int bk_exact_reserve_coupling(exact_backend *eb)
+{
+    exact_shared *s = eb->shared;
+    if (eb->n_couplings == s->couplings_cap) {
+        size_t cap = s->couplings_cap ? 2 * s->couplings_cap : 256;
+        coupling *grown = realloc(s->couplings, cap * sizeof *grown);
+        if (!grown)
+            return -1;
+        s->couplings = grown;
+        s->couplings_cap = cap;
+    }
+    eb->couplings = s->couplings;
+    return 0;
+}
+
+int bk_exact_reserve_work(exact_backend *eb, size_t largest, bk_error *err)
+{
+    exact_shared *s = eb->shared;
+    double *modes = large_enough(s->modes, &s->modes_cap, largest * largest + 3 * largest + 1, sizeof *modes);
+    if (!modes)
+        return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for the modes of %zu pairs",
+                       largest);
+    eb->work = s->modes = modes;
+    return BK_OK;
+}
+
 static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roots, bk_error *err)
 {
-    size_t need = 7 * n + 14 * p + 4 * m * p + 2 * m + 1;
-    if (need > eb->arena_cap) {
+    exact_shared *s = eb->shared;
+    double *work = large_enough(s->start, &s->start_cap, 5 * n + 1, sizeof *work);
+    if (work)
+        s->start = work;
+    size_t *indices =
+        work ? large_enough(s->indices, &s->indices_cap, 3 * (p + 1), sizeof *indices) : NULL;
+    if (!indices)
+        return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu components", n);
+    s->indices = indices;
+    double *w = s->start;
+    eb->f0 = w, w += n;
+    eb->probe = w, w += n;
+    eb->scale = w, w += n;
+    eb->delta = w, w += n;
+    eb->predicted = w;
+    eb->cluster_of = s->indices;
+    eb->local = s->indices + p + 1;
+    eb->parent = s->indices + 2 * (p + 1);
+    eb->couplings = s->couplings;
+
+    size_t need = 2 * n + 14 * p + 4 * m * p + 2 * m + 1;
+    if (!bk_capacity_fits(need, eb->arena_cap)) {
         double *grown = malloc(need * sizeof *grown);
         if (!grown)
             return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu components", n);
@@ -80,12 +173,7 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     }
     double *a = eb->arena;
     eb->y0 = a, a += n;
-    eb->f0 = a, a += n;
     eb->scratch = a, a += n;
-    eb->probe = a, a += n;
-    eb->scale = a, a += n;
-    eb->delta = a, a += n;
-    eb->predicted = a, a += n;
     eb->sqrt_mass = a, a += p;
     eb->omega2 = a, a += p;
     eb->omega = a, a += p;
@@ -107,8 +195,8 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->qdot0 = a, a += m;
     eb->q_rate = a;
 
-    size_t need_indices = 7 * (p + 1);
-    if (need_indices > eb->indices_cap) {
+    size_t need_indices = 4 * (p + 1);
+    if (!bk_capacity_fits(need_indices, eb->indices_cap)) {
         size_t *grown = malloc(need_indices * sizeof *grown);
         if (!grown)
             return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu pairs", p);
@@ -120,12 +208,9 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->members = ix, ix += p + 1;
     eb->first = ix, ix += p + 1;
     eb->offset = ix, ix += p + 1;
-    eb->cluster_of = ix, ix += p + 1;
-    eb->local = ix, ix += p + 1;
-    eb->uniform = ix, ix += p + 1;
-    eb->parent = ix;
+    eb->uniform = ix;
 
-    if (n_roots > eb->roots_cap) {
+    if (n_roots > 0 && !bk_capacity_fits(n_roots, eb->roots_cap)) {
         free(eb->direction);
         free(eb->sign);
         free(eb->found);
@@ -147,15 +232,14 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     return BK_OK;
 }
 
-/* Room for the clusters' S and T (`total` doubles each) and one work copy of `largest`^2. */
 static int create(void **mem, const bk_solver_options *options, bk_error *err)
 {
     exact_backend *eb = calloc(1, sizeof *eb);
     if (!eb)
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory");
-    eb->options = *options;
-    eb->brent = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
-    if (!eb->brent) {
+    eb->max_step = options->max_step;
+    eb->shared = shared_acquire();
+    if (!eb->shared) {
         free(eb);
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for the root finder");
     }
@@ -170,10 +254,9 @@ static void destroy(void *mem)
         return;
     if (eb->eigen)
         gsl_eigen_symmv_free(eb->eigen);
-    gsl_root_fsolver_free(eb->brent);
+    shared_release(eb->shared);
     free(eb->arena);
     free(eb->indices);
-    free(eb->couplings);
     free(eb->matrices);
     free(eb->direction);
     free(eb->sign);
@@ -234,7 +317,13 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     memset(eb->P, 0, eb->m * p * sizeof *eb->P);
     memset(eb->Q, 0, eb->m * p * sizeof *eb->Q);
 
-    if ((rc = bk_exact_read_problem(eb, err)) != BK_OK || (rc = bk_exact_modes(eb, err)) != BK_OK)
+    if ((rc = bk_exact_read_problem(eb, err)) == BK_OK)
+        rc = bk_exact_modes(eb, err);
+    /* the shared work space now serves other instances */
+    eb->f0 = eb->probe = eb->scale = eb->delta = eb->predicted = eb->work = NULL;
+    eb->cluster_of = eb->local = eb->parent = NULL;
+    eb->couplings = NULL;
+    if (rc != BK_OK)
         return rc;
 
     if (eb->n_roots > 0) {
@@ -336,7 +425,7 @@ static int locate(exact_backend *eb, size_t i, double lo, double hi, double g_hi
             *t_root = hi;
             return BK_OK;
         }
-        int rc = gsl_root_fsolver_set(eb->brent, &fn, lo, hi);
+        int rc = gsl_root_fsolver_set(eb->shared->brent, &fn, lo, hi);
         if (rp.status != BK_OK)
             return rp.status;
         if (rc != GSL_SUCCESS)
@@ -345,7 +434,7 @@ static int locate(exact_backend *eb, size_t i, double lo, double hi, double g_hi
                            i, lo, hi, gsl_strerror(rc));
         double a = lo, b = hi;
         for (int iter = 0; iter < BRENT_MAX_ITER; ++iter) {
-            rc = gsl_root_fsolver_iterate(eb->brent);
+            rc = gsl_root_fsolver_iterate(eb->shared->brent);
             // cppcheck-suppress knownConditionTrueFalse ; set through fn.params by the callback
             if (rp.status != BK_OK)
                 return rp.status;
@@ -353,8 +442,8 @@ static int locate(exact_backend *eb, size_t i, double lo, double hi, double g_hi
                 return BK_FAIL(err, BK_ERR_SOLVER,
                                "exact stepper: locating root function %zu failed: %s", i,
                                gsl_strerror(rc));
-            a = gsl_root_fsolver_x_lower(eb->brent);
-            b = gsl_root_fsolver_x_upper(eb->brent);
+            a = gsl_root_fsolver_x_lower(eb->shared->brent);
+            b = gsl_root_fsolver_x_upper(eb->shared->brent);
             if (b - a <= 2.0 * DBL_EPSILON * fmax(fabs(a), fabs(b)))
                 break;
         }

@@ -11,6 +11,7 @@
 #include <gsl/gsl_roots.h>
 
 #include "bksim/solver.h"
+#include "capacity.h"
 
 #define PI 3.14159265358979323846
 #define SAMPLES_PER_PERIOD 16.0
@@ -29,23 +30,40 @@ typedef struct coupling {
     double value;
 } coupling;
 
+/* What no instance needs between two calls, shared by the thread's instances (calls never
+ * interleave, and a long chain keeps one instance per island alive): a start's work space
+ * and the root finder.  Reference-counted; an instance stays in the thread that made it. */
+typedef struct exact_shared {
+    double *start;              /* f0, probe, scale, delta, predicted: n each */
+    size_t start_cap;
+    double *modes;              /* one cluster's work copy: largest^2 + 3 largest + 1 */
+    size_t modes_cap;
+    size_t *indices;            /* cluster_of, local, parent: p + 1 each */
+    size_t indices_cap;
+    coupling *couplings;
+    size_t couplings_cap;
+    gsl_root_fsolver *brent;
+    size_t users;
+} exact_shared;
+
 /* A problem the Jacobian shows the stepper cannot solve (first offending entry). */
 enum { JACOBIAN_OK, JACOBIAN_NOMEM, JACOBIAN_RANGE, JACOBIAN_VELOCITY, JACOBIAN_QUADRATURE };
 
 typedef struct exact_backend {
-    bk_solver_options options;
+    double max_step;            /* s, [solver] max_step: all the stepper reads of its options */
     bk_ode_problem problem;
     size_t n, p, m, n_roots;    /* state size, pairs, quadratures, root functions */
     double t0, t_stop, h;       /* start, stop, sampling step */
     double t_now;               /* time reached by the last step */
     double t_lo, t_hi;          /* the last step */
 
-    /* One arena for everything sized by p, m and n; regrown only when it must. */
+    /* One arena for everything sized by p, m and n; reallocated only when it does not fit. */
     double *arena;
     size_t arena_cap;
     double *y0;                 /* n: the starting state */
-    double *f0, *scratch, *probe, *scale, *delta, *predicted; /* n each: rates at the start,
-                                                                 work space */
+    double *scratch;            /* n: the state where the root functions are evaluated */
+    /* During a start only, in the shared work space: rates at the start, work space. */
+    double *f0, *probe, *scale, *delta, *predicted; /* n each */
     double *sqrt_mass;          /* p */
     double *omega2, *omega;     /* p, by mode (a cluster's modes follow its first's) */
     double *c, *g, *d;          /* p: modal initial velocity, forcing, forcing rate */
@@ -60,15 +78,16 @@ typedef struct exact_backend {
      * its modes are first[k] .. first[k + 1], its matrices start at offset[k]. */
     size_t *indices;
     size_t indices_cap;
-    size_t *members, *first, *offset, *cluster_of, *local, *parent; /* p (+1) each */
+    size_t *members, *first, *offset; /* p (+1) each */
+    size_t *cluster_of, *local, *parent; /* p (+1) each, during a start only (shared) */
     size_t *uniform;            /* per cluster: it moves as one (see the top of the file) */
     size_t n_clusters;
-    coupling *couplings;        /* K's entries */
-    size_t n_couplings, couplings_cap;
-    double *matrices;           /* S of each cluster (in place), then T = M^(-1/2) U of each,
-                                   then one cluster's work copy */
+    coupling *couplings;        /* K's entries, during a start only (shared) */
+    size_t n_couplings;
+    double *matrices;           /* S of each cluster (in place), then T = M^(-1/2) U of each */
     size_t matrices_cap;
-    double *S, *T, *work;
+    double *S, *T;
+    double *work;               /* one cluster's work copy, during a start only (shared) */
     gsl_eigen_symmv_workspace *eigen;
     int jacobian_status;
     size_t bad_row, bad_col;
@@ -80,7 +99,7 @@ typedef struct exact_backend {
     int *found;
     double *g_hi, *g_try, *root_t;
     double g_try_time;          /* when g_try was evaluated (NAN: not since the start) */
-    gsl_root_fsolver *brent;
+    exact_shared *shared;
 
     bk_solver_counters counters;
 } exact_backend;
@@ -89,6 +108,10 @@ typedef struct exact_backend {
 /* exact_matrices.c: the affine forcing at t0 and K, P, Q (from the Jacobian when the problem
  * has one, else one probe per column); the right-hand side checked for finite values. */
 int bk_exact_read_problem(exact_backend *eb, bk_error *err);
+/* exact.c: room for n_couplings + 1 couplings in the shared work space; -1: out of memory. */
+int bk_exact_reserve_coupling(exact_backend *eb);
+/* exact.c: the shared work copy for a cluster of `largest` pairs into eb->work. */
+int bk_exact_reserve_work(exact_backend *eb, size_t largest, bk_error *err);
 /* exact_modes.c: clusters and their modes (after bk_exact_read_problem); the exact state at t. */
 int bk_exact_modes(exact_backend *eb, bk_error *err);
 void bk_exact_state(exact_backend *eb, double t, double *y);

@@ -10,14 +10,8 @@
 
 static int add_coupling(exact_backend *eb, size_t row, size_t col, double value)
 {
-    if (eb->n_couplings == eb->couplings_cap) {
-        size_t cap = eb->couplings_cap ? 2 * eb->couplings_cap : 256;
-        coupling *grown = realloc(eb->couplings, cap * sizeof *grown);
-        if (!grown)
-            return -1;
-        eb->couplings = grown;
-        eb->couplings_cap = cap;
-    }
+    if (bk_exact_reserve_coupling(eb) != 0)
+        return -1;
     eb->couplings[eb->n_couplings++] = (coupling){row, col, value};
     return 0;
 }

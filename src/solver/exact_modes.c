@@ -99,8 +99,8 @@ void bk_exact_state(exact_backend *eb, double t, double *y)
 
 static int reserve_matrices(exact_backend *eb, size_t total, size_t largest, bk_error *err)
 {
-    size_t need = 2 * total + largest * largest + 3 * largest + 1;
-    if (need > eb->matrices_cap) {
+    size_t need = 2 * total + 1;
+    if (!bk_capacity_fits(need, eb->matrices_cap)) {
         double *grown = malloc(need * sizeof *grown);
         if (!grown)
             return BK_FAIL(err, BK_ERR_NOMEM,
@@ -111,8 +111,7 @@ static int reserve_matrices(exact_backend *eb, size_t total, size_t largest, bk_
     }
     eb->S = eb->matrices;
     eb->T = eb->S + total;
-    eb->work = eb->T + total;
-    return BK_OK;
+    return bk_exact_reserve_work(eb, largest, err);
 }
 
 static size_t find_set(size_t *parent, size_t i)
@@ -412,7 +411,7 @@ int bk_exact_modes(exact_backend *eb, bk_error *err)
     /* Sampling step: a sixteenth of the shortest period, max_step, else a sixteenth of the
      * span (polynomial motion only). */
     double h = lambda_max > 0.0 ? 2.0 * PI / (SAMPLES_PER_PERIOD * sqrt(lambda_max)) : INFINITY;
-    double max_step = eb->options.max_step;
+    double max_step = eb->max_step;
     if (isfinite(max_step) && max_step > 0.0 && max_step < h)
         h = max_step;
     if (!isfinite(h)) {

@@ -47,6 +47,7 @@
 #include <gsl/gsl_roots.h>
 
 #include "bksim/solver.h"
+#include "capacity.h"
 #include "gsl_shared.h"
 
 typedef enum { DENSE_RESTEP, DENSE_HERMITE } dense_kind;
@@ -75,9 +76,8 @@ typedef struct gsl_backend {
      * control through a driver, so each instance owns one; the RK pairs carry nothing but
      * evolve's dydt_out, which step() refills from f_lo, so they borrow shared ones. */
     gsl_odeiv2_driver *driver;  /* msbdf: owns stepper, control and evolve */
-    bk_gsl_shared *shared;     /* RK: stepper, probe, evolve and control, borrowed */
+    bk_gsl_shared *shared;     /* RK: borrowed stepper (also the dense-output probe), evolve, control */
     gsl_odeiv2_step *stepper;
-    gsl_odeiv2_step *probe;     /* second stepper for DENSE_RESTEP */
     gsl_odeiv2_evolve *evolve;
     gsl_odeiv2_control *control;
     size_t driver_n;            /* msbdf: the size the driver was made for */
@@ -177,7 +177,7 @@ static int dense(gsl_backend *b, double t, double *out)
     }
     if (b->variant->dense == DENSE_RESTEP) {
         memcpy(out, b->y_lo, n * sizeof *out);
-        return gsl_odeiv2_step_apply(b->probe, b->t_lo, t - b->t_lo, out, b->yerr, b->f_lo, NULL,
+        return gsl_odeiv2_step_apply(b->stepper, b->t_lo, t - b->t_lo, out, b->yerr, b->f_lo, NULL,
                                      &b->sys);
     }
     double h = b->t_hi - b->t_lo, s = (t - b->t_lo) / h, r = 1.0 - s;
@@ -359,7 +359,7 @@ static void free_steppers(gsl_backend *b)
     bk_gsl_shared_release(b->shared);
     b->driver = NULL;
     b->shared = NULL;
-    b->stepper = b->probe = NULL;
+    b->stepper = NULL;
     b->evolve = NULL;
     b->control = NULL;
     b->driver_n = 0;
@@ -379,9 +379,10 @@ static void free_arrays(gsl_backend *b)
  * blocks cost a cache miss each at every turn. */
 static int reserve(gsl_backend *b, size_t n, size_t m)
 {
-    if (n <= b->capacity && m <= b->root_capacity)
+    int n_fits = bk_capacity_fits(n, b->capacity), m_fits = bk_capacity_fits(m, b->root_capacity);
+    if (n_fits && m_fits)
         return 0;
-    size_t cap_n = n > b->capacity ? n : b->capacity, cap_m = m > b->root_capacity ? m : b->root_capacity;
+    size_t cap_n = n_fits ? b->capacity : n, cap_m = m_fits ? b->root_capacity : m;
     double *arena = malloc((11 * cap_n + 4 * cap_m + 1) * sizeof *arena);
     int *flags = malloc((2 * cap_m + 1) * sizeof *flags);
     if (!arena || !flags) {
@@ -516,7 +517,6 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
             b->shared = bk_gsl_shared_acquire(*b->variant->type, n);
             if (b->shared) {
                 b->stepper = b->shared->stepper;
-                b->probe = b->shared->probe;
                 b->evolve = b->shared->evolve;
                 b->control = b->shared->control;
             }

@@ -82,7 +82,8 @@ static const gsl_odeiv2_control_type scaled_control_type = {
 /* The RK objects of one size, shared by this thread's instances: a long chain runs
  * thousands of islands in turn, and objects of their own (16 n doubles of stages and
  * copies in a dozen allocations) would be cold at every turn.  Sharing is exact: an RK
- * step reads nothing left by the last one except evolve's dydt_out, refilled per step.
+ * step reads nothing left by the last one except evolve's dydt_out, refilled per step, so
+ * the stepper also serves as the probe that re-steps for dense output.
  * Reference-counted; an instance stays in the thread that made it. */
 #define SHARED_BUCKETS 64
 static _Thread_local bk_gsl_shared *shared_table[SHARED_BUCKETS];
@@ -91,8 +92,6 @@ static void shared_free(bk_gsl_shared *s)
 {
     if (s->stepper)
         gsl_odeiv2_step_free(s->stepper);
-    if (s->probe)
-        gsl_odeiv2_step_free(s->probe);
     if (s->evolve)
         gsl_odeiv2_evolve_free(s->evolve);
     if (s->control)
@@ -111,9 +110,9 @@ bk_gsl_shared *bk_gsl_shared_acquire(const gsl_odeiv2_step_type *type, size_t n)
     bk_gsl_shared *s = calloc(1, sizeof *s);
     if (!s)
         return NULL;
-    *s = (bk_gsl_shared){type, n, 1, gsl_odeiv2_step_alloc(type, n), gsl_odeiv2_step_alloc(type, n),
+    *s = (bk_gsl_shared){type, n, 1, gsl_odeiv2_step_alloc(type, n),
                      gsl_odeiv2_evolve_alloc(n), gsl_odeiv2_control_alloc(&scaled_control_type), *bucket};
-    if (!s->stepper || !s->probe || !s->evolve || !s->control) {
+    if (!s->stepper || !s->evolve || !s->control) {
         shared_free(s);
         return NULL;
     }

@@ -1,5 +1,5 @@
 /* What the GSL Runge-Kutta back-ends share (gsl.c): a scaled step-size control that reads its
- * weights through a pointer, and the stepper, probe, evolve and control of one size, shared
+ * weights through a pointer, and the stepper, evolve and control of one size, shared
  * by one thread's instances. */
 #ifndef BKSIM_GSL_SHARED_H
 #define BKSIM_GSL_SHARED_H
@@ -11,7 +11,7 @@
 typedef struct bk_gsl_shared {
     const gsl_odeiv2_step_type *type;
     size_t n, users;
-    gsl_odeiv2_step *stepper, *probe;
+    gsl_odeiv2_step *stepper;     /* also the probe that re-steps for dense output */
     gsl_odeiv2_evolve *evolve;
     gsl_odeiv2_control *control; /* set per step with bk_gsl_control_weights */
     struct bk_gsl_shared *next;  /* same bucket */
