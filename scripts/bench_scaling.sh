@@ -11,7 +11,9 @@
 #   scripts/bench_scaling.sh [--quick | --plot-only] OUTDIR
 # writes OUTDIR/scaling.tsv, scaling_slopes.tsv (least-squares slope of log CPU per
 # transition against log N over the full-window sizes, and the ratio at 1e5 over 1e3),
-# scaling.png and scaling_memory.png.
+# scaling.png and scaling_memory.png; and peak memory against the length of a run on the
+# random chain (scaling_run_length.tsv, scaling_run_length.png): a long run's memory must
+# follow the chain, not the run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 quick=0 plot_only=0
@@ -36,6 +38,14 @@ short_window() { [ "$1" = uniform ] && echo 0.7 || echo 0.3; }
 # cvode_bdf's band solver on every island is an order slower: its largest full-window size
 # would take about 15 minutes at 1e5 blocks (1e4 takes 100 s), so it runs the short window there.
 bdf_full_max=10000
+# Run lengths for the memory-over-time rows: the random chain at long_n blocks, windows that
+# double, for exact and the default integrator; then the 1e6-block chain for 0.3 s and 1 s (13
+# million transitions) with exact.
+if [ $quick = 1 ]; then
+    long_n=1000; lengths=(0.7 1.4 2.8); long_big=0
+else
+    long_n=100000; lengths=(0.5 1 2); long_big=1
+fi
 
 scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
@@ -93,6 +103,18 @@ if [ $plot_only = 0 ]; then
             done
         done
     done
+
+    # The same rows for runs of growing length, into their own table.
+    full_tsv=$tsv
+    tsv=$out/scaling_run_length.tsv
+    head -n 1 "$full_tsv" > "$tsv"
+    for t in "${lengths[@]}"; do
+        for m in exact gsl_rk8pd; do
+            run random "$long_n" "$m" "$t"
+        done
+    done
+    if [ $long_big = 1 ]; then run random 1000000 exact 0.3 && run random 1000000 exact 1; fi
+    tsv=$full_tsv
 fi
 
 # Slopes over the full-window sizes (>= 100 blocks), and the ratio 1e5 : 1e3 when both ran.
@@ -158,3 +180,31 @@ set key top left
 f(x) = 1e-3 * x
 plot $plots_mem, f(x) with lines dt 3 lc rgb '#777777' title '1 kB per block'
 GP
+
+# Peak memory against the transitions a run made, one curve per chain length and method:
+# flat when memory follows the chain.
+lengths_tsv=$out/scaling_run_length.tsv
+if [ -s "$lengths_tsv" ]; then
+    plots_len="" k=0
+    for key in $(awk -F'\t' 'NR > 1 && $5 == "ok" {print $2 ":" $3}' "$lengths_tsv" | sort -u -t: -k1,1n -k2); do
+        n=${key%%:*} m=${key#*:}
+        f=$scratch/len_${n}_$m.dat
+        awk -F'\t' -v n="$n" -v m="$m" 'NR > 1 && $2 == n && $3 == m && $5 == "ok" {print $6, $10}' "$lengths_tsv" > "$f"
+        pt=$([ "$m" = exact ] && echo 7 || echo 5)
+        plots_len="$plots_len${plots_len:+, }'$f' using 1:2 with linespoints lw 2 pt $pt ps 1.4 lc $((k + 1)) title '$m, N = $n'"
+        k=$((k + 1))
+    done
+    gnuplot <<GP
+set terminal pngcairo size 1200,800 font 'Sans,12' noenhanced
+set output '$out/scaling_run_length.png'
+set title 'Peak resident memory vs length of the run (random chain, interval = 0)'
+set logscale x
+set xlabel 'transitions in the run'
+set ylabel 'peak resident memory [MB]'
+set yrange [0:*]
+set format x '1e%L'
+set grid
+set key top left
+plot $plots_len
+GP
+fi

@@ -67,6 +67,15 @@ awk -F'\t' -v window="$window" '
 echo "| chain | method | sizes (same window) | slope of CPU per transition vs N | CPU per transition, 1e5 / 1e3 blocks |"
 echo "| --- | --- | --- | --- | --- |"
 awk -F'\t' 'NR > 1 {printf "| %s | %s | %s | %s | %s |\n", $1, $2, $4, $5, $6}' "$dir/scaling_slopes.tsv"
+# Peak memory against the length of a run (random chain): flat when it follows the chain.
+if [ -s "$dir/scaling_run_length.tsv" ]; then
+    echo
+    echo "| N (random chain) | method | t_end | transitions | CPU per transition | peak resident memory |"
+    echo "| --- | --- | --- | --- | --- | --- |"
+    awk -F'\t' 'NR > 1 { printf "| %s | %s | %s s | %s | %s | %s |\n", $2, $3, $4, $6,
+                         $5 == "ok" ? sprintf("%.3g us", 1e6 * $9) : "failed", $5 == "ok" ? sprintf("%.0f MB", $10) : "-" }' \
+        "$dir/scaling_run_length.tsv"
+fi
 [ -e "$dir/scaling_machine.txt" ] && echo && echo "Measured on: $(paste -sd ';' "$dir/scaling_machine.txt" | sed 's/;/; /g')"
 echo
 

@@ -74,15 +74,6 @@ void bk_run_islands_free(run_ctx *ctx)
     bk_heap_free(&ctx->island_queue);
 }
 
-static void add_counters(bk_solver_counters *total, const bk_solver_counters *c)
-{
-    total->steps += c->steps;
-    total->rhs_evals += c->rhs_evals;
-    total->root_evals += c->root_evals;
-    total->err_test_fails += c->err_test_fails;
-    total->nonlin_iters += c->nonlin_iters;
-}
-
 void bk_run_solver_counters(const run_ctx *ctx, bk_solver_counters *total)
 {
     *total = ctx->retired;
@@ -90,11 +81,11 @@ void bk_run_solver_counters(const run_ctx *ctx, bk_solver_counters *total)
     for (size_t id = 0; id < ctx->islands_used; ++id)
         if (ctx->islands[id]->solver) {
             ctx->backend->counters(ctx->islands[id]->solver, &c);
-            add_counters(total, &c);
+            bk_solver_counters_add(total, &c);
         }
     for (size_t k = 0; k < ctx->n_idle; ++k) {
         ctx->backend->counters(ctx->idle[k], &c);
-        add_counters(total, &c);
+        bk_solver_counters_add(total, &c);
     }
 }
 
@@ -162,7 +153,7 @@ static void give_back_solver(run_ctx *ctx, run_island *isl)
     }
     bk_solver_counters c;
     ctx->backend->counters(solver, &c);
-    add_counters(&ctx->retired, &c);
+    bk_solver_counters_add(&ctx->retired, &c);
     ctx->backend->destroy(solver);
 }
 

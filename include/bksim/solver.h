@@ -56,6 +56,8 @@ typedef struct bk_ode_problem {
 typedef struct bk_solver_counters {
     long steps, rhs_evals, root_evals, err_test_fails, nonlin_iters;
 } bk_solver_counters;
+/* sum += more, counter by counter. */
+void bk_solver_counters_add(bk_solver_counters *sum, const bk_solver_counters *more);
 
 enum {
     BK_STEP_OK = 0,      /* a step was taken; *t_reached < t_stop */

@@ -62,28 +62,19 @@ int bk_sundials_no_memory(const bk_sundials_base *base, size_t n, bk_error *err)
     return BK_FAIL(err, BK_ERR_NOMEM, "%s: cannot allocate a problem of size %zu", base->package, n);
 }
 
-static void add_counters(bk_solver_counters *sum, const bk_solver_counters *more)
-{
-    sum->steps += more->steps;
-    sum->rhs_evals += more->rhs_evals;
-    sum->root_evals += more->root_evals;
-    sum->err_test_fails += more->err_test_fails;
-    sum->nonlin_iters += more->nonlin_iters;
-}
-
 void bk_sundials_begin_start(bk_sundials_base *base, const bk_ode_problem *problem,
                              bk_solver_counters finished)
 {
     base->problem = *problem;
     base->message[0] = '\0';
-    add_counters(&base->done, &finished);
+    bk_solver_counters_add(&base->done, &finished);
 }
 
 void bk_sundials_counters(const bk_sundials_base *base, bk_solver_counters current,
                           bk_solver_counters *total)
 {
     *total = base->done;
-    add_counters(total, &current);
+    bk_solver_counters_add(total, &current);
 }
 
 int bk_sundials_new_vectors(bk_sundials_base *base, size_t n, bk_error *err)
