@@ -481,8 +481,40 @@ static void test_commands(void **state)
     snprintf(cmd, sizeof cmd, "./bksim info %s/nothing.h5", tmpdir);
     assert_int_equal(run_command(cmd, NULL), 1);
 
-    const char *helps[] = {"run", "check", "info", "export", "keys"};
-    for (size_t k = 0; k < 5; ++k) {
+    /* stats: a run's output holds no catalog yet; a table of t_start and magnitude does. */
+    snprintf(cmd, sizeof cmd, "./bksim stats %s", out);
+    assert_int_equal(run_command(cmd, &text), 1);
+    assert_non_null(strstr(text, "/events"));
+    free(text);
+    char catalog[512];
+    snprintf(catalog, sizeof catalog, "%s/catalog.h5", tmpdir);
+    typedef struct { double t_start, magnitude; } row;
+    row rows_out[40];
+    for (size_t k = 0; k < 40; ++k) /* 2.0 x 20, 2.1 x 10, 2.2 x 5, 2.3 x 5 */
+        rows_out[k] = (row){(double)k, k < 20 ? 2.0 : k < 30 ? 2.1 : k < 35 ? 2.2 : 2.3};
+    hid_t file = H5Fcreate(catalog, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t type = H5Tcreate(H5T_COMPOUND, sizeof(row));
+    H5Tinsert(type, "t_start", HOFFSET(row, t_start), H5T_NATIVE_DOUBLE);
+    H5Tinsert(type, "magnitude", HOFFSET(row, magnitude), H5T_NATIVE_DOUBLE);
+    hsize_t dims[1] = {40};
+    hid_t space = H5Screate_simple(1, dims, NULL);
+    hid_t dset = H5Dcreate2(file, "events", type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    assert_true(H5Dwrite(dset, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows_out) >= 0);
+    H5Dclose(dset);
+    H5Sclose(space);
+    H5Tclose(type);
+    H5Fclose(file);
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --mc 2.0 --json", catalog);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_non_null(strstr(text, "\"n_events\": 40"));
+    assert_non_null(strstr(text, "\"b_value\""));
+    free(text);
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --bin -1", catalog);
+    assert_int_equal(run_command(cmd, NULL), 2);
+    assert_int_equal(run_command("./bksim stats", NULL), 2);
+
+    const char *helps[] = {"run", "check", "info", "export", "keys", "stats"};
+    for (size_t k = 0; k < 6; ++k) {
         snprintf(cmd, sizeof cmd, "./bksim %s --help", helps[k]);
         assert_int_equal(run_command(cmd, &text), 0);
         assert_non_null(strstr(text, "usage: bksim"));

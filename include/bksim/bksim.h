@@ -4,6 +4,7 @@
 
 #define BKSIM_VERSION "0.1.0"
 
+#include "bksim/catalog.h"
 #include "bksim/checkpoint.h"
 #include "bksim/config.h"
 #include "bksim/driver.h"
@@ -15,6 +16,7 @@
 #include "bksim/param.h"
 #include "bksim/run.h"
 #include "bksim/solver.h"
+#include "bksim/stats.h"
 #include "bksim/status.h"
 
 #endif

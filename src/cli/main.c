@@ -30,6 +30,8 @@ static const char *const usage_text =
     "  info OUT.h5          summarise an output file\n"
     "  export OUT.h5 [--datasets a,b,...] [--block I] [--transitions]\n"
     "                       print columns for gnuplot and shell tools\n"
+    "  stats FILE [--mc auto|VALUE] [--bin DM] [--json] [--tsv DIR]\n"
+    "                       earthquake statistics of the catalog /events in FILE\n"
     "  keys                 print the config key reference (Markdown)\n"
     "  --version            print the version\n"
     "\n"
@@ -73,6 +75,22 @@ static const char *const export_help =
     "                    cof,mode); per-block datasets give one column per block\n"
     "  --block I         only block I (0-based) of the per-block datasets\n"
     "  --transitions     print the /transitions table instead\n";
+
+static const char *const stats_help =
+    "usage: bksim stats FILE [--mc auto|VALUE] [--bin DM] [--json] [--tsv DIR]\n"
+    "\n"
+    "Statistics of the earthquake catalog /events in the HDF5 file FILE (a table with at\n"
+    "least t_start and magnitude): magnitude-frequency distribution, completeness magnitude\n"
+    "Mc, b-value (Aki-Utsu maximum likelihood, Shi & Bolt error), potency exponent, event\n"
+    "sizes, recurrence intervals, and a KS test of the two halves of the run.  Events still\n"
+    "running at the end (complete = 0) are left out.\n"
+    "  --mc auto|VALUE   completeness magnitude: maximum curvature + 0.2 (auto, the\n"
+    "                    default) or VALUE, a multiple of the bin width\n"
+    "  --bin DM          magnitude bin width, 0 < DM <= 10 (default 0.1)\n"
+    "  --json            print one JSON object instead of the text report\n"
+    "  --tsv DIR         also write tables for gnuplot to DIR (created if missing): mfd.tsv,\n"
+    "                    gr_fit.tsv, sizes.tsv, sizes_log2.tsv, intervals.tsv,\n"
+    "                    potency_ccdf.tsv\n";
 
 static const char *const keys_help =
     "usage: bksim keys\n"
@@ -412,6 +430,74 @@ static int cmd_export(int argc, char **argv)
     return 0;
 }
 
+static int cmd_stats(int argc, char **argv)
+{
+    if (wants_help(argc, argv)) {
+        fputs(stats_help, stdout);
+        return 0;
+    }
+    bk_stats_options opt;
+    bk_stats_options_default(&opt);
+    const char *path = NULL, *tsv_dir = NULL;
+    int json = 0;
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        const char *value = NULL;
+        if ((strcmp(a, "--mc") == 0 || strcmp(a, "--bin") == 0 || strcmp(a, "--tsv") == 0) &&
+            i + 1 < argc)
+            value = argv[++i];
+        else if (strncmp(a, "--mc=", 5) == 0 || strncmp(a, "--bin=", 6) == 0 ||
+                 strncmp(a, "--tsv=", 6) == 0)
+            value = strchr(a, '=') + 1;
+        /* Ranges (finite, a bin centre, ...) are bk_stats_options_check's. */
+        char *end = NULL;
+        errno = 0;
+        if (value && strncmp(a, "--mc", 4) == 0) {
+            opt.mc_auto = strcmp(value, "auto") == 0;
+            if (!opt.mc_auto) {
+                opt.mc = strtod(value, &end);
+                if (errno || end == value || *end)
+                    return usage_error("stats", "--mc needs 'auto' or a magnitude, got '%s'",
+                                       value);
+            }
+        } else if (value && strncmp(a, "--bin", 5) == 0) {
+            opt.dm = strtod(value, &end);
+            if (errno || end == value || *end)
+                return usage_error("stats", "--bin needs a bin width 0 < DM <= 10, got '%s'",
+                                   value);
+        } else if (value) {
+            tsv_dir = value;
+        } else if (strcmp(a, "--json") == 0) {
+            json = 1;
+        } else if (a[0] == '-') {
+            return usage_error("stats", "unknown or incomplete option '%s'", a);
+        } else if (!path) {
+            path = a;
+        } else {
+            return usage_error("stats", "unexpected argument '%s'", a);
+        }
+    }
+    if (!path)
+        return usage_error("stats", "%s", "missing FILE");
+    bk_error err = {0};
+    if (bk_stats_options_check(&opt, &err) != BK_OK)
+        return usage_error("stats", "%s", err.message);
+    bk_stats_report *report = NULL;
+    int rc = bk_stats_report_read(path, &opt, &report, &err);
+    /* Tables first: a directory that cannot be written fails before anything is printed. */
+    if (rc == BK_OK && tsv_dir)
+        rc = bk_stats_report_tsv(report, tsv_dir, &err);
+    if (rc == BK_OK)
+        rc = json ? bk_stats_report_json(report, stdout, &err)
+                  : bk_stats_report_text(report, stdout, &err);
+    bk_stats_report_free(report);
+    if (rc != BK_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return EXIT_RUN_FAILED;
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -429,6 +515,8 @@ int main(int argc, char **argv)
         return cmd_info(rest, rest_argv);
     if (strcmp(command, "export") == 0)
         return cmd_export(rest, rest_argv);
+    if (strcmp(command, "stats") == 0)
+        return cmd_stats(rest, rest_argv);
     if (strcmp(command, "keys") == 0) {
         if (wants_help(rest, rest_argv)) {
             fputs(keys_help, stdout);

@@ -1,0 +1,258 @@
+/* Earthquake-catalog statistics: the numbers behind `bksim stats FILE`.
+ *
+ * The estimators (src/stats.c) are pure numerics on plain arrays: no HDF5, no printing.
+ * The report (src/output/h5_stats.c) reads a catalog's /events table from any HDF5 file and
+ * prints or writes what the estimators give.
+ *
+ * Magnitude bins.  Bins of width dm are centred on multiples of dm: a magnitude M belongs to
+ * bin k = floor(M/dm + 0.5 + eps), eps = BK_MAG_BIN_EPS, whose centre is k dm.  The epsilon
+ * keeps catalog magnitudes written to dm's precision (2.35 stored as 2.3499999999999996)
+ * in the bin their decimal text names: half-way values round up, as in SeismoStats.  Every
+ * magnitude statistic below works on binned magnitudes, and "M >= Mc" means "the bin of M
+ * is at or above the bin Mc", i.e. M >= Mc - dm/2 for continuous magnitudes.
+ *
+ * Completeness magnitude Mc.  Maximum curvature (Wiemer & Wyss 2000): the centre of the
+ * bin of the incremental distribution with the most events (the lowest such bin on a tie),
+ * plus a correction, +0.2 by default (Woessner & Wiemer 2005, BSSA 95(2), 684-698), which
+ * is rounded to whole bins so that Mc stays a bin centre (2 bins at dm = 0.1).
+ *
+ * b-value.  Aki's (1965) maximum-likelihood estimator with Utsu's (1966) correction for
+ * binned magnitudes:
+ *
+ *     b = log10(e) / (mean(M >= Mc) - (Mc - dm/2)),
+ *
+ * where the mean is over the binned magnitudes of the bins >= Mc.  It is the continuous
+ * estimator with the threshold moved to the lower edge of the Mc bin, the form of
+ * SeismoStats' UtsuBValueEstimator (not Tinti & Mulargia's exact discrete estimator).
+ * Its standard error is Shi & Bolt's (1982, BSSA 72(5), 1677-1687)
+ *
+ *     sigma_b = ln(10) b^2 sqrt( sum (M_i - mean)^2 / (n (n - 1)) ),
+ *
+ * with ln(10) = 2.3026 where Shi & Bolt printed 2.30; Aki's b / sqrt(n) is given as well.
+ * The a-value is log10(n) + b Mc: the catalog's count N(M >= Mc) = 10^(a - b Mc).
+ *
+ * Potency exponent.  For potencies P >= P_min the continuous power-law maximum-likelihood
+ * estimate (e.g. Clauset, Shalizi & Newman 2009, eq. 3.1) of the density exponent,
+ *
+ *     alpha = 1 + n / sum ln(P_i / P_min),   sigma_alpha = (alpha - 1) / sqrt(n).
+ *
+ * The cumulative count falls as P^-(alpha - 1); with magnitudes m = (2/3) log10 P + const,
+ * N(>= m) ~ 10^(-b m) = P^(-(2/3) b), so beta = alpha - 1 = (2/3) b.
+ *
+ * Two-sample Kolmogorov-Smirnov test.  D = max |F1 - F2| of the empirical distribution
+ * functions, exact with ties (a tied value steps both functions before they are compared);
+ * the p-value is the asymptotic Q_KS(lambda) with lambda = (sqrt(ne) + 0.12 + 0.11/sqrt(ne)) D,
+ * ne = n1 n2 / (n1 + n2) (Stephens 1970; Numerical Recipes, section 14.3).
+ *
+ * Every function returns BK_OK or a negative status, with a message in err that names
+ * what was wrong and the allowed range. */
+#ifndef BKSIM_STATS_H
+#define BKSIM_STATS_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "bksim/status.h"
+
+#define BK_STATS_DEFAULT_DM 0.1
+#define BK_MAXC_CORRECTION 0.2
+/* In units of one bin: see "Magnitude bins" above. */
+#define BK_MAG_BIN_EPS 1e-9
+/* A magnitude-frequency distribution of more bins than this is refused (a bin width far
+ * too small for the magnitudes' range). */
+#define BK_MFD_MAX_BINS 10000000L
+
+/* -------------------------------------------------------------- binning --- */
+
+/* The bin of m (see above); BK_ERR_INVALID for a non-finite m or dm <= 0, or when m/dm is
+ * beyond +-1e15 (no integer bin index). */
+int bk_mag_bin(double m, double dm, long *bin, bk_error *err);
+
+/* The incremental and cumulative magnitude-frequency distribution. */
+typedef struct bk_mfd {
+    double dm;             /* bin width */
+    long first_bin;        /* bin index of entry 0: its centre is first_bin * dm */
+    size_t n_bins;         /* from the lowest to the highest occupied bin */
+    size_t n_events;
+    size_t *incremental;   /* events in bin first_bin + i */
+    size_t *cumulative;    /* events in bins >= first_bin + i */
+} bk_mfd;
+
+/* The distribution of n >= 1 finite magnitudes in bins of width dm > 0.  mfd is
+ * overwritten (free it with bk_mfd_free). */
+int bk_mfd_build(const double *m, size_t n, double dm, bk_mfd *mfd, bk_error *err);
+/* Centre of entry i. */
+double bk_mfd_centre(const bk_mfd *mfd, size_t i);
+void bk_mfd_free(bk_mfd *mfd);
+
+/* ------------------------------------------------- completeness, b-value --- */
+
+/* Mc by maximum curvature plus correction (finite; rounded to whole bins), from a built
+ * distribution; *mc is a bin centre. */
+int bk_mc_maxc(const bk_mfd *mfd, double correction, double *mc, bk_error *err);
+
+typedef struct bk_b_estimate {
+    double mc, dm;      /* the completeness magnitude (a bin centre) and the bin width */
+    size_t n;           /* magnitudes in bins >= Mc */
+    double mean;        /* their mean binned magnitude */
+    double b;           /* Aki-Utsu maximum likelihood */
+    double sigma;       /* Shi & Bolt standard error */
+    double sigma_aki;   /* b / sqrt(n) */
+    double a;           /* log10(n) + b Mc */
+} bk_b_estimate;
+
+/* The b-value of the finite magnitudes m[0..n) at or above mc, which must be a bin centre
+ * (a multiple of dm to within 1e-6 of a bin); BK_ERR_INVALID when fewer than 2 magnitudes
+ * are at or above Mc.  Magnitudes below Mc are ignored. */
+int bk_b_value(const double *m, size_t n, double mc, double dm, bk_b_estimate *out,
+               bk_error *err);
+/* Shi & Bolt's standard error of b for the magnitudes m[0..n) as given (no binning, no
+ * threshold), n >= 2: ln(10) b^2 sqrt(sum (m_i - mean)^2 / (n (n - 1))). */
+int bk_shi_bolt(const double *m, size_t n, double b, double *sigma, bk_error *err);
+
+/* ------------------------------------------------------- potency exponent --- */
+
+typedef struct bk_power_law {
+    double x_min;   /* the threshold */
+    size_t n;       /* values >= x_min */
+    double alpha;   /* density exponent: p(x) ~ x^-alpha */
+    double sigma;   /* (alpha - 1) / sqrt(n) */
+} bk_power_law;
+
+/* The exponent of the values x >= x_min > 0 (values below are ignored, NaN is refused);
+ * BK_ERR_INVALID when fewer than 2 values are at or above x_min, or all equal x_min. */
+int bk_power_law_mle(const double *x, size_t n, double x_min, bk_power_law *out,
+                     bk_error *err);
+
+/* ------------------------------------------------------------------ sizes --- */
+
+typedef struct bk_size_dist {
+    size_t n_events;
+    int32_t max_size;
+    double mean;
+    size_t *count;        /* count[s], s = 0..max_size: events that involved s blocks */
+    size_t n_log2;
+    size_t *log2_count;   /* bin j: sizes 2^j .. 2^(j+1) - 1 */
+} bk_size_dist;
+
+/* The distribution of n >= 1 event sizes (blocks per event, each >= 1). */
+int bk_size_dist_build(const int32_t *size, size_t n, bk_size_dist *out, bk_error *err);
+void bk_size_dist_free(bk_size_dist *dist);
+
+/* ------------------------------------------------------------- recurrence --- */
+
+typedef struct bk_recurrence {
+    double m_min;       /* the magnitude threshold (-inf: every event) */
+    size_t n_events;    /* events at or above it */
+    double mean;        /* mean interval between their consecutive starts, s */
+    double sd;          /* sample standard deviation of the intervals, s */
+    double cv;          /* sd / mean */
+    size_t n_intervals; /* n_events - 1 */
+    double *interval;   /* the intervals in time order */
+    double *t;          /* the start of the later event of each interval */
+} bk_recurrence;
+
+/* Intervals between the sorted start times t of the events with m >= m_min (m may be NULL:
+ * every event).  NaN times or magnitudes are refused; at least 3 events are needed (2
+ * intervals for a standard deviation) and the mean interval must be > 0. */
+int bk_recurrence_intervals(const double *t, const double *m, size_t n, double m_min,
+                            bk_recurrence *out, bk_error *err);
+void bk_recurrence_free(bk_recurrence *rec);
+
+/* ------------------------------------------------------ Kolmogorov-Smirnov --- */
+
+/* The Kolmogorov survival function Q_KS(lambda) = 2 sum_{j>=1} (-1)^(j-1) exp(-2 j^2 lambda^2)
+ * (its theta-function form below lambda = 1.18, where that series converges slowly);
+ * 1 for lambda <= 0, NaN for NaN. */
+double bk_ks_q(double lambda);
+
+typedef struct bk_ks_result {
+    size_t n1, n2;
+    double d;        /* the statistic */
+    double ne;       /* n1 n2 / (n1 + n2) */
+    double lambda;   /* (sqrt(ne) + 0.12 + 0.11 / sqrt(ne)) d */
+    double p;        /* Q_KS(lambda) */
+} bk_ks_result;
+
+/* Two samples of n1, n2 >= 1 values (not NaN; neither array is modified). */
+int bk_ks_two_sample(const double *x1, size_t n1, const double *x2, size_t n2,
+                     bk_ks_result *out, bk_error *err);
+
+/* ----------------------------------------------------------------- report --- */
+
+typedef struct bk_stats_options {
+    double dm;             /* bin width, > 0 */
+    int mc_auto;           /* 1: maximum curvature plus mc_correction; 0: mc below */
+    double mc;             /* a multiple of dm */
+    double mc_correction;  /* BK_MAXC_CORRECTION */
+} bk_stats_options;
+
+void bk_stats_options_default(bk_stats_options *opt);
+/* BK_ERR_INVALID with a message naming the option and its allowed range. */
+int bk_stats_options_check(const bk_stats_options *opt, bk_error *err);
+
+/* Everything `bksim stats` reports about one catalog.  A statistic the catalog cannot
+ * support (too few events above Mc, no potency field...) has have_* = 0 and the reason in
+ * its *_note; the report as a whole fails only when the file is no catalog. */
+typedef struct bk_stats_report {
+    char *path;
+    bk_stats_options options;
+    /* the columns found in /events */
+    int has_t_end, has_potency, has_n_blocks, has_complete;
+    size_t n_rows;         /* rows of /events */
+    size_t n_incomplete;   /* complete = 0: still running at the end, left out */
+    size_t n_nonfinite;    /* complete rows without a finite t_start and magnitude */
+    size_t n_events;       /* the rest: the events every magnitude statistic uses */
+    /* the analysed events, in file order */
+    double *t_start, *magnitude, *potency;  /* potency NULL without the field */
+    double t_first, t_last;
+    double duration;       /* s: the run's t_reached, else t_last - t_first */
+    int duration_from_run; /* 1: the root attribute t_reached of a bksim output */
+    double rate;           /* n_events / duration, 1/s (0 when the duration is 0) */
+    double m_min, m_max;
+    int have_mfd;
+    bk_mfd mfd;
+    int have_mc;
+    double mc;
+    size_t n_above_mc;
+    double rate_above_mc;
+    int have_b;
+    bk_b_estimate b;
+    char b_note[BK_ERROR_MESSAGE_LEN];
+    int have_potency_exponent;
+    bk_power_law potency_fit;
+    int potency_threshold_from_mc; /* 1: P_min is the potency of Mc - dm/2 */
+    double magnitude_offset;       /* M - (2/3) log10 P when that holds for every event */
+    char potency_note[BK_ERROR_MESSAGE_LEN];
+    int have_recurrence;
+    bk_recurrence recurrence;      /* events at or above Mc */
+    char recurrence_note[BK_ERROR_MESSAGE_LEN];
+    int have_sizes;
+    bk_size_dist sizes;            /* complete events, any magnitude */
+    char sizes_note[BK_ERROR_MESSAGE_LEN];
+    int have_ks;
+    bk_ks_result ks;               /* magnitudes >= Mc, first vs second half of the time span */
+    double ks_t_split;
+    char ks_note[BK_ERROR_MESSAGE_LEN];
+} bk_stats_report;
+
+/* Read /events of the HDF5 file path (read-only) and compute everything; *out is
+ * allocated (bk_stats_report_free).  Fails on a file that cannot be read, has no /events,
+ * or whose /events lacks t_start or magnitude. */
+int bk_stats_report_read(const char *path, const bk_stats_options *opt, bk_stats_report **out,
+                         bk_error *err);
+void bk_stats_report_free(bk_stats_report *report);
+/* The human-readable report; BK_ERR_IO when writing fails. */
+int bk_stats_report_text(const bk_stats_report *report, FILE *out, bk_error *err);
+/* One JSON object (and a newline). */
+int bk_stats_report_json(const bk_stats_report *report, FILE *out, bk_error *err);
+/* Tab-separated tables for gnuplot in dir (created when missing; one level), each with a
+ * '#' header line of column names and units: mfd.tsv (magnitude, incremental, cumulative),
+ * gr_fit.tsv (the fitted cumulative count 10^(a - b M) from Mc up), sizes.tsv (n_blocks,
+ * count; sizes that occur), sizes_log2.tsv (sizes 2^j..2^(j+1)-1, count, count per size),
+ * intervals.tsv (t_start, interval of the events >= Mc), potency_ccdf.tsv (potency, events
+ * at or above it).  A table whose statistic is unavailable is not written. */
+int bk_stats_report_tsv(const bk_stats_report *report, const char *dir, bk_error *err);
+
+#endif

@@ -1,0 +1,207 @@
+/* The event catalog builder (bksim/catalog.h).  Per block it keeps what its current event
+ * needs (where its slip began, its forces, whether the event has seen it); per event, the
+ * list of blocks involved, so that closing an event costs what the event touched. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bksim/catalog.h"
+#include "bksim/modes.h"
+
+struct bk_catalog {
+    size_t n;
+    int ring;
+    double magnitude_offset;
+    /* Per block. */
+    double *x_onset;      /* m, position where its current slip episode began */
+    double *first_force;  /* N, applied force at its first onset in the current event */
+    double *last_force;   /* N, applied force at its last stick in the current event */
+    long *seen;           /* the last event (serial) it slipped in; -1: none */
+    int8_t *slipping;
+    size_t n_slipping;
+    /* The current event. */
+    long serial;
+    int open;
+    int pending;          /* nothing slips since t_pending: the event ends unless an onset
+                             at that same instant carries it on */
+    double t_pending;
+    bk_event event;
+    int32_t *involved;    /* its blocks, in the order they first slipped */
+    size_t n_involved, involved_capacity;
+};
+
+bk_catalog *bk_catalog_create(size_t n_blocks, int ring, double magnitude_offset)
+{
+    bk_catalog *c = calloc(1, sizeof *c);
+    if (!c)
+        return NULL;
+    c->n = n_blocks;
+    c->ring = ring;
+    c->magnitude_offset = magnitude_offset;
+    c->x_onset = malloc(n_blocks * sizeof *c->x_onset);
+    c->first_force = malloc(n_blocks * sizeof *c->first_force);
+    c->last_force = malloc(n_blocks * sizeof *c->last_force);
+    c->seen = malloc(n_blocks * sizeof *c->seen);
+    c->slipping = calloc(n_blocks, sizeof *c->slipping);
+    if (!c->x_onset || !c->first_force || !c->last_force || !c->seen || !c->slipping) {
+        bk_catalog_free(c);
+        return NULL;
+    }
+    for (size_t i = 0; i < n_blocks; ++i)
+        c->seen[i] = -1;
+    c->serial = -1;
+    return c;
+}
+
+void bk_catalog_free(bk_catalog *c)
+{
+    if (!c)
+        return;
+    free(c->x_onset);
+    free(c->first_force);
+    free(c->last_force);
+    free(c->seen);
+    free(c->slipping);
+    free(c->involved);
+    free(c);
+}
+
+static int onset(bk_catalog *c, size_t i, double t, double x, double force)
+{
+    if (!c->open) {
+        c->open = 1;
+        c->serial++;
+        c->n_involved = 0;
+        c->event = (bk_event){.t_start = t, .first_block = (int32_t)i, .complete = 1};
+    } else if (t == c->event.t_start && (int32_t)i < c->event.first_block) {
+        c->event.first_block = (int32_t)i; /* simultaneous first onsets: the lowest index */
+    }
+    c->pending = 0;
+    c->x_onset[i] = x;
+    c->slipping[i] = 1;
+    c->n_slipping++;
+    if (c->seen[i] != c->serial) {
+        if (c->n_involved == c->involved_capacity) {
+            size_t cap = c->involved_capacity ? 2 * c->involved_capacity : 64;
+            int32_t *grown = realloc(c->involved, cap * sizeof *grown);
+            if (!grown)
+                return BK_ERR_NOMEM;
+            c->involved = grown;
+            c->involved_capacity = cap;
+        }
+        c->involved[c->n_involved++] = (int32_t)i;
+        c->seen[i] = c->serial;
+        c->first_force[i] = force;
+    }
+    return BK_OK;
+}
+
+static void episode_end(bk_catalog *c, size_t i, double x, double force)
+{
+    c->event.potency += fabs(x - c->x_onset[i]);
+    c->event.n_episodes++;
+    c->last_force[i] = force;
+}
+
+static int compare_blocks(const void *a, const void *b)
+{
+    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* The extent: on a chain the first and last block; on a ring the shorter arc covering the
+ * blocks, the complement of the largest gap between two of them. */
+static void extent(bk_catalog *c, bk_event *e)
+{
+    size_t k = c->n_involved;
+    qsort(c->involved, k, sizeof *c->involved, compare_blocks);
+    e->left = c->involved[0];
+    e->right = c->involved[k - 1];
+    if (!c->ring || k == 1)
+        return;
+    /* The gap after the last block wraps round to the first. */
+    int64_t widest = (int64_t)c->n - c->involved[k - 1] + c->involved[0];
+    for (size_t j = 1; j < k; ++j) {
+        int64_t gap = (int64_t)c->involved[j] - c->involved[j - 1];
+        if (gap > widest) {
+            widest = gap;
+            e->left = c->involved[j];
+            e->right = c->involved[j - 1];
+        }
+    }
+}
+
+static void close_event(bk_catalog *c, double t_end, bk_event *out)
+{
+    bk_event *e = &c->event;
+    e->t_end = t_end;
+    e->n_blocks = (int32_t)c->n_involved;
+    double drop = 0.0;
+    for (size_t j = 0; j < c->n_involved; ++j)
+        drop += c->first_force[c->involved[j]] - c->last_force[c->involved[j]];
+    e->stress_drop = drop / (double)c->n_involved;
+    e->magnitude = e->potency > 0.0 ? 2.0 / 3.0 * log10(e->potency) + c->magnitude_offset : -INFINITY;
+    extent(c, e);
+    *out = *e;
+    c->open = 0;
+    c->pending = 0;
+}
+
+int bk_catalog_begin(bk_catalog *c, double t, const int8_t *mode, const double *x,
+                     bk_catalog_force_fn force, const void *user)
+{
+    for (size_t i = 0; i < c->n; ++i)
+        if (mode[i] != BK_MODE_STICK) {
+            int rc = onset(c, i, t, x[i], force(user, i));
+            if (rc != BK_OK)
+                return rc;
+        }
+    return BK_OK;
+}
+
+int bk_catalog_add(bk_catalog *c, const bk_transition *tr, bk_event *event, int *done)
+{
+    *done = 0;
+    if (tr->block < 0 || (size_t)tr->block >= c->n)
+        return BK_ERR_INVALID;
+    if (c->pending && tr->t > c->t_pending) {
+        close_event(c, c->t_pending, event);
+        *done = 1;
+    }
+    size_t i = (size_t)tr->block;
+    int slips = tr->to != BK_MODE_STICK;
+    if (!c->slipping[i] && slips)
+        return onset(c, i, tr->t, tr->x, tr->force);
+    if (c->slipping[i] && !slips) {
+        episode_end(c, i, tr->x, tr->force);
+        c->slipping[i] = 0;
+        if (--c->n_slipping == 0) {
+            c->pending = 1;
+            c->t_pending = tr->t;
+        }
+    }
+    return BK_OK; /* a reversal (slip + to slip -) goes on with the same episode */
+}
+
+int bk_catalog_finish(bk_catalog *c, double t, const double *x, bk_catalog_force_fn force,
+                      const void *user, bk_event *event)
+{
+    if (c->pending) {
+        close_event(c, c->t_pending, event);
+        return 1;
+    }
+    if (!c->open)
+        return 0;
+    /* Still running: its open episodes counted to t, its blocks' forces there. */
+    for (size_t j = 0; j < c->n_involved; ++j) {
+        size_t i = (size_t)c->involved[j];
+        if (c->slipping[i]) {
+            episode_end(c, i, x[i], force(user, i));
+            c->slipping[i] = 0;
+        }
+    }
+    c->n_slipping = 0;
+    close_event(c, t, event);
+    event->complete = 0;
+    return 1;
+}

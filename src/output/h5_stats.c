@@ -1,0 +1,507 @@
+/* `bksim stats`: read an earthquake catalog (/events of any HDF5 file), run the estimators
+ * of stats.c on it (src/stats_print.c presents the result).
+ *
+ * A catalog needs only t_start and magnitude; the other fields of bksim's own catalogs
+ * (potency, n_blocks, complete, t_end) add statistics when present.  Each field is read on
+ * its own through a one-member compound memory type, so HDF5 converts whatever numeric
+ * type the file holds and the order and the other members of the table do not matter. */
+#include "bksim/stats.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "output/h5_impl.h"
+
+#define TWO_THIRDS (2.0 / 3.0)
+/* Magnitudes and potencies obey m = (2/3) log10 P + offset to this (in magnitude units) in
+ * a bksim catalog; 1e-6 leaves room for a catalog written in single precision elsewhere. */
+#define OFFSET_TOLERANCE 1e-6
+
+void bk_stats_options_default(bk_stats_options *opt)
+{
+    opt->dm = BK_STATS_DEFAULT_DM;
+    opt->mc_auto = 1;
+    opt->mc = 0.0;
+    opt->mc_correction = BK_MAXC_CORRECTION;
+}
+
+int bk_stats_options_check(const bk_stats_options *opt, bk_error *err)
+{
+    if (!(isfinite(opt->dm) && opt->dm > 0.0 && opt->dm <= 10.0))
+        return BK_FAIL(err, BK_ERR_INVALID, "magnitude bin width %g: allowed 0 < dm <= 10",
+                       opt->dm);
+    if (!isfinite(opt->mc_correction))
+        return BK_FAIL(err, BK_ERR_INVALID, "Mc correction %g: must be finite",
+                       opt->mc_correction);
+    if (!opt->mc_auto) {
+        double q = opt->mc / opt->dm;
+        if (!(isfinite(q) && fabs(q) <= 1e15) || fabs(q - floor(q + 0.5)) > 1e-6)
+            return BK_FAIL(err, BK_ERR_INVALID,
+                           "Mc = %g: must be a bin centre, a multiple of the bin width %g "
+                           "(bins are centred on multiples of dm)",
+                           opt->mc, opt->dm);
+    }
+    return BK_OK;
+}
+
+/* ------------------------------------------------------------ reading --- */
+
+/* The columns of /events as read, one entry per row. */
+typedef struct events_table {
+    size_t n;
+    double *t_start, *magnitude, *t_end, *potency;
+    int32_t *n_blocks;
+    int8_t *complete;
+} events_table;
+
+static void events_table_free(events_table *t)
+{
+    free(t->t_start);
+    free(t->magnitude);
+    free(t->t_end);
+    free(t->potency);
+    free(t->n_blocks);
+    free(t->complete);
+    memset(t, 0, sizeof *t);
+}
+
+/* The member names of the compound file type, comma-separated, for a message. */
+static void member_names(hid_t type, char *buf, size_t len)
+{
+    buf[0] = '\0';
+    int members = H5Tget_nmembers(type);
+    size_t used = 0;
+    for (int i = 0; i < members && used + 1 < len; ++i) {
+        char *name = H5Tget_member_name(type, (unsigned)i);
+        if (!name)
+            continue;
+        int w = snprintf(buf + used, len - used, "%s%s", i ? ", " : "", name);
+        H5free_memory(name);
+        if (w < 0)
+            break;
+        used += (size_t)w;
+    }
+    if (used >= len && len > 4)
+        strcpy(buf + len - 4, "...");
+}
+
+/* Field name of the table as mem_type values into a new array *out (NULL and BK_OK when
+ * the table has no such field; an error when it is there but not numeric). */
+static int read_field(hid_t dset, hid_t file_type, const char *path, size_t n, const char *name,
+                      hid_t mem_type, void **out, bk_error *err)
+{
+    *out = NULL;
+    int index = H5Tget_member_index(file_type, name);
+    if (index < 0) {
+        H5Eclear2(H5E_DEFAULT);
+        return BK_OK;
+    }
+    H5T_class_t cls = H5Tget_member_class(file_type, (unsigned)index);
+    if (cls != H5T_INTEGER && cls != H5T_FLOAT)
+        return BK_FAIL(err, BK_ERR_INVALID, "%s: /events field '%s' is not numeric", path, name);
+    size_t elem = H5Tget_size(mem_type);
+    void *buf = malloc(n ? n * elem : 1);
+    if (!buf)
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for %zu /events rows", path, n);
+    if (n > 0) {
+        hid_t mem = H5Tcreate(H5T_COMPOUND, elem);
+        herr_t rc = mem < 0 ? -1 : H5Tinsert(mem, name, 0, mem_type);
+        if (rc >= 0)
+            rc = H5Dread(dset, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
+        if (rc < 0) {
+            int status = H5_DAMAGED(err, "%s: cannot read field '%s' of /events", path, name);
+            CLOSE_IDS(-1, mem);
+            free(buf);
+            return status;
+        }
+        CLOSE_IDS(0, mem);
+    }
+    *out = buf;
+    return BK_OK;
+}
+
+static int read_events(hid_t file, const char *path, events_table *t, bk_error *err)
+{
+    memset(t, 0, sizeof *t);
+    htri_t exists = H5Lexists(file, "events", H5P_DEFAULT);
+    if (exists <= 0)
+        return BK_FAIL(err, BK_ERR_INVALID,
+                       "%s: no /events table (an earthquake catalog: a 1-D compound dataset "
+                       "with at least the fields t_start and magnitude)",
+                       path);
+    hid_t dset = H5Dopen2(file, "events", H5P_DEFAULT);
+    if (dset < 0)
+        return H5_FAIL(err, "%s: /events is not a readable dataset", path);
+    hid_t type = H5Dget_type(dset);
+    hid_t space = H5Dget_space(dset);
+    int rc = BK_OK;
+    if (type < 0 || space < 0) {
+        rc = H5_DAMAGED(err, "%s: cannot read the type and shape of /events", path);
+        goto done;
+    }
+    if (H5Tget_class(type) != H5T_COMPOUND || H5Sget_simple_extent_ndims(space) != 1) {
+        rc = BK_FAIL(err, BK_ERR_INVALID,
+                     "%s: /events must be a 1-D compound dataset (a table with fields t_start, "
+                     "magnitude, ...)",
+                     path);
+        goto done;
+    }
+    hsize_t rows = 0;
+    H5Sget_simple_extent_dims(space, &rows, NULL);
+    t->n = (size_t)rows;
+    const char *required[] = {"t_start", "magnitude"};
+    for (size_t k = 0; k < 2; ++k)
+        if (H5Tget_member_index(type, required[k]) < 0) {
+            H5Eclear2(H5E_DEFAULT);
+            char names[512];
+            member_names(type, names, sizeof names);
+            rc = BK_FAIL(err, BK_ERR_INVALID,
+                         "%s: /events has no field '%s' (a catalog needs t_start and magnitude; "
+                         "fields present: %s)",
+                         path, required[k], names[0] ? names : "none");
+            goto done;
+        }
+    void *p;
+    if ((rc = read_field(dset, type, path, t->n, "t_start", H5T_NATIVE_DOUBLE, &p, err)) != BK_OK)
+        goto done;
+    t->t_start = p;
+    if ((rc = read_field(dset, type, path, t->n, "magnitude", H5T_NATIVE_DOUBLE, &p, err)) != BK_OK)
+        goto done;
+    t->magnitude = p;
+    if ((rc = read_field(dset, type, path, t->n, "t_end", H5T_NATIVE_DOUBLE, &p, err)) != BK_OK)
+        goto done;
+    t->t_end = p;
+    if ((rc = read_field(dset, type, path, t->n, "potency", H5T_NATIVE_DOUBLE, &p, err)) != BK_OK)
+        goto done;
+    t->potency = p;
+    if ((rc = read_field(dset, type, path, t->n, "n_blocks", H5T_NATIVE_INT32, &p, err)) != BK_OK)
+        goto done;
+    t->n_blocks = p;
+    if ((rc = read_field(dset, type, path, t->n, "complete", H5T_NATIVE_INT8, &p, err)) != BK_OK)
+        goto done;
+    t->complete = p;
+done:
+    CLOSE_IDS(rc, space, type, dset);
+    if (rc != BK_OK)
+        events_table_free(t);
+    return rc;
+}
+
+/* ------------------------------------------------------------ computing --- */
+
+/* A statistic the catalog cannot support is noted, not fatal; anything else (memory) is. */
+static int note_or_fail(int rc, const bk_error *inner, char *note, size_t len, bk_error *err)
+{
+    if (rc == BK_ERR_INVALID) {
+        snprintf(note, len, "%s", inner->message);
+        return BK_OK;
+    }
+    if (err)
+        *err = *inner;
+    return rc;
+}
+
+/* Duration and rates: the run's simulated span when the file is a bksim output (runs start
+ * at t = 0), else the span of the catalog itself. */
+static void set_duration(bk_stats_report *r, hid_t file, const events_table *t)
+{
+    double t_reached = 0.0;
+    if (H5Aexists(file, "t_reached") > 0 &&
+        bk_h5_read_numeric_attr(file, "t_reached", H5T_NATIVE_DOUBLE, &t_reached) >= 0 &&
+        isfinite(t_reached) && t_reached > 0.0 && t_reached >= r->t_last) {
+        r->duration = t_reached;
+        r->duration_from_run = 1;
+    } else {
+        H5Eclear2(H5E_DEFAULT);
+        double end = r->t_last;
+        if (t->t_end)
+            for (size_t i = 0; i < t->n; ++i)
+                if (isfinite(t->t_end[i]) && t->t_end[i] > end && isfinite(t->t_start[i]))
+                    end = t->t_end[i];
+        r->duration = r->n_events ? end - r->t_first : 0.0;
+    }
+    r->rate = r->duration > 0.0 ? (double)r->n_events / r->duration : 0.0;
+}
+
+/* The potency threshold: the potency of the lower edge of the Mc bin when the catalog's
+ * magnitudes are (2/3) log10 P plus one offset (bksim's are), so that the exponent and b
+ * describe the same events; else the smallest potency among the events at or above Mc. */
+static int fit_potency(bk_stats_report *r, const double *binned, bk_error *err)
+{
+    size_t n = r->n_events, count = 0;
+    double *p = malloc((n ? n : 1) * sizeof *p);
+    if (!p)
+        return BK_FAIL(err, BK_ERR_NOMEM, "out of memory for %zu potencies", n);
+    double off_lo = INFINITY, off_hi = -INFINITY, p_above = INFINITY;
+    for (size_t i = 0; i < n; ++i) {
+        double pot = r->potency[i];
+        if (!(isfinite(pot) && pot > 0.0))
+            continue;
+        p[count++] = pot;
+        double off = r->magnitude[i] - TWO_THIRDS * log10(pot);
+        off_lo = fmin(off_lo, off);
+        off_hi = fmax(off_hi, off);
+        if (binned[i] >= r->mc && pot < p_above)
+            p_above = pot;
+    }
+    double p_min;
+    if (count > 0 && off_hi - off_lo <= OFFSET_TOLERANCE) {
+        r->magnitude_offset = 0.5 * (off_lo + off_hi);
+        r->potency_threshold_from_mc = 1;
+        p_min = pow(10.0, 1.5 * (r->mc - 0.5 * r->options.dm - r->magnitude_offset));
+    } else if (isfinite(p_above)) {
+        p_min = p_above;
+    } else {
+        snprintf(r->potency_note, sizeof r->potency_note,
+                 "no event at or above Mc = %g has a positive, finite potency", r->mc);
+        free(p);
+        return BK_OK;
+    }
+    bk_error inner = {0};
+    int rc = bk_power_law_mle(p, count, p_min, &r->potency_fit, &inner);
+    free(p);
+    if (rc == BK_OK) {
+        r->have_potency_exponent = 1;
+        return BK_OK;
+    }
+    return note_or_fail(rc, &inner, r->potency_note, sizeof r->potency_note, err);
+}
+
+/* The magnitudes at or above Mc, first half of the time span against the second: a
+ * catalog whose loading has not settled (a spin-up still in it) fails this test. */
+static int ks_halves(bk_stats_report *r, const double *binned, bk_error *err)
+{
+    double t0 = r->duration_from_run ? 0.0 : r->t_first;
+    r->ks_t_split = t0 + 0.5 * r->duration;
+    double *first = malloc((r->n_events ? r->n_events : 1) * sizeof *first);
+    double *second = malloc((r->n_events ? r->n_events : 1) * sizeof *second);
+    if (!first || !second) {
+        free(first);
+        free(second);
+        return BK_FAIL(err, BK_ERR_NOMEM, "out of memory for %zu magnitudes", r->n_events);
+    }
+    size_t n1 = 0, n2 = 0;
+    for (size_t i = 0; i < r->n_events; ++i)
+        if (binned[i] >= r->mc) {
+            if (r->t_start[i] < r->ks_t_split)
+                first[n1++] = r->magnitude[i];
+            else
+                second[n2++] = r->magnitude[i];
+        }
+    bk_error inner = {0};
+    int rc = n1 && n2 ? bk_ks_two_sample(first, n1, second, n2, &r->ks, &inner) : BK_ERR_INVALID;
+    free(first);
+    free(second);
+    if (rc == BK_OK) {
+        r->have_ks = 1;
+        return BK_OK;
+    }
+    if (rc == BK_ERR_INVALID && !(n1 && n2)) {
+        snprintf(r->ks_note, sizeof r->ks_note,
+                 "%zu and %zu events at or above Mc = %g before and after t = %g s: the KS test "
+                 "needs at least 1 in each half",
+                 n1, n2, r->mc, r->ks_t_split);
+        return BK_OK;
+    }
+    return note_or_fail(rc, &inner, r->ks_note, sizeof r->ks_note, err);
+}
+
+/* Everything that needs Mc. */
+static int above_mc(bk_stats_report *r, bk_error *err)
+{
+    const bk_stats_options *o = &r->options;
+    bk_error inner = {0};
+    int rc;
+    if (o->mc_auto) {
+        if ((rc = bk_mc_maxc(&r->mfd, o->mc_correction, &r->mc, &inner)) != BK_OK)
+            return note_or_fail(rc, &inner, r->b_note, sizeof r->b_note, err);
+    } else {
+        r->mc = o->mc;
+    }
+    r->have_mc = 1;
+    double *binned = malloc(r->n_events * sizeof *binned);
+    if (!binned)
+        return BK_FAIL(err, BK_ERR_NOMEM, "out of memory for %zu magnitudes", r->n_events);
+    /* Binned magnitudes are k dm and Mc is k_mc dm: comparing them compares bin indices. */
+    long k_mc = (long)floor(r->mc / o->dm + 0.5);
+    r->mc = (double)k_mc * o->dm;
+    for (size_t i = 0; i < r->n_events; ++i) {
+        long k = 0;
+        bk_mag_bin(r->magnitude[i], o->dm, &k, NULL);
+        binned[i] = (double)k * o->dm;
+        r->n_above_mc += k >= k_mc;
+    }
+    r->rate_above_mc = r->duration > 0.0 ? (double)r->n_above_mc / r->duration : 0.0;
+
+    rc = bk_b_value(r->magnitude, r->n_events, r->mc, o->dm, &r->b, &inner);
+    if (rc == BK_OK)
+        r->have_b = 1;
+    else
+        rc = note_or_fail(rc, &inner, r->b_note, sizeof r->b_note, err);
+    if (rc == BK_OK && r->potency)
+        rc = fit_potency(r, binned, err);
+    if (rc == BK_OK) {
+        rc = bk_recurrence_intervals(r->t_start, binned, r->n_events, r->mc, &r->recurrence,
+                                     &inner);
+        if (rc == BK_OK)
+            r->have_recurrence = 1;
+        else
+            rc = note_or_fail(rc, &inner, r->recurrence_note, sizeof r->recurrence_note, err);
+    }
+    if (rc == BK_OK)
+        rc = ks_halves(r, binned, err);
+    free(binned);
+    return rc;
+}
+
+static int compute_sizes(bk_stats_report *r, const events_table *t, bk_error *err)
+{
+    if (!t->n_blocks) {
+        snprintf(r->sizes_note, sizeof r->sizes_note, "the catalog has no n_blocks field");
+        return BK_OK;
+    }
+    int32_t *sizes = malloc((t->n ? t->n : 1) * sizeof *sizes);
+    if (!sizes)
+        return BK_FAIL(err, BK_ERR_NOMEM, "out of memory for %zu event sizes", t->n);
+    size_t n = 0;
+    for (size_t i = 0; i < t->n; ++i)
+        if (!t->complete || t->complete[i] != 0)
+            sizes[n++] = t->n_blocks[i];
+    bk_error inner = {0};
+    int rc = bk_size_dist_build(sizes, n, &r->sizes, &inner);
+    free(sizes);
+    if (rc == BK_OK) {
+        r->have_sizes = 1;
+        return BK_OK;
+    }
+    return note_or_fail(rc, &inner, r->sizes_note, sizeof r->sizes_note, err);
+}
+
+/* Keep the complete rows with a finite start and magnitude. */
+static int select_events(bk_stats_report *r, const events_table *t, bk_error *err)
+{
+    size_t n = t->n ? t->n : 1;
+    r->t_start = malloc(n * sizeof *r->t_start);
+    r->magnitude = malloc(n * sizeof *r->magnitude);
+    r->potency = t->potency ? malloc(n * sizeof *r->potency) : NULL;
+    if (!r->t_start || !r->magnitude || (t->potency && !r->potency))
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for %zu events", r->path, t->n);
+    for (size_t i = 0; i < t->n; ++i) {
+        if (t->complete && t->complete[i] == 0) {
+            ++r->n_incomplete;
+            continue;
+        }
+        if (!isfinite(t->t_start[i]) || !isfinite(t->magnitude[i])) {
+            ++r->n_nonfinite;
+            continue;
+        }
+        size_t k = r->n_events++;
+        r->t_start[k] = t->t_start[i];
+        r->magnitude[k] = t->magnitude[i];
+        if (r->potency)
+            r->potency[k] = t->potency[i];
+        if (k == 0 || t->t_start[i] < r->t_first)
+            r->t_first = t->t_start[i];
+        if (k == 0 || t->t_start[i] > r->t_last)
+            r->t_last = t->t_start[i];
+        if (k == 0 || t->magnitude[i] < r->m_min)
+            r->m_min = t->magnitude[i];
+        if (k == 0 || t->magnitude[i] > r->m_max)
+            r->m_max = t->magnitude[i];
+    }
+    return BK_OK;
+}
+
+static int compute(bk_stats_report *r, hid_t file, const events_table *t, bk_error *err)
+{
+    r->n_rows = t->n;
+    r->has_t_end = t->t_end != NULL;
+    r->has_potency = t->potency != NULL;
+    r->has_n_blocks = t->n_blocks != NULL;
+    r->has_complete = t->complete != NULL;
+    int rc = select_events(r, t, err);
+    if (rc != BK_OK)
+        return rc;
+    set_duration(r, file, t);
+    if ((rc = compute_sizes(r, t, err)) != BK_OK)
+        return rc;
+    if (!r->has_potency)
+        snprintf(r->potency_note, sizeof r->potency_note, "the catalog has no potency field");
+    if (r->n_events == 0) {
+        const char *none = "no complete event with a finite t_start and magnitude";
+        snprintf(r->b_note, sizeof r->b_note, "%s", none);
+        snprintf(r->recurrence_note, sizeof r->recurrence_note, "%s", none);
+        snprintf(r->ks_note, sizeof r->ks_note, "%s", none);
+        if (r->has_potency)
+            snprintf(r->potency_note, sizeof r->potency_note, "%s", none);
+        return BK_OK;
+    }
+    bk_error inner = {0};
+    rc = bk_mfd_build(r->magnitude, r->n_events, r->options.dm, &r->mfd, &inner);
+    if (rc != BK_OK) {
+        /* e.g. magnitudes spanning too many bins: the message says so. */
+        rc = note_or_fail(rc, &inner, r->b_note, sizeof r->b_note, err);
+        snprintf(r->recurrence_note, sizeof r->recurrence_note, "%s", r->b_note);
+        snprintf(r->ks_note, sizeof r->ks_note, "%s", r->b_note);
+        if (r->has_potency)
+            snprintf(r->potency_note, sizeof r->potency_note, "%s", r->b_note);
+        return rc;
+    }
+    r->have_mfd = 1;
+    return above_mc(r, err);
+}
+
+int bk_stats_report_read(const char *path, const bk_stats_options *opt, bk_stats_report **out,
+                         bk_error *err)
+{
+    *out = NULL;
+    bk_stats_options defaults;
+    bk_stats_options_default(&defaults);
+    if (!opt)
+        opt = &defaults;
+    int rc = bk_stats_options_check(opt, err);
+    if (rc != BK_OK)
+        return rc;
+    hid_t file;
+    if ((rc = bk_h5_open_input(path, &file, err)) != BK_OK)
+        return rc;
+    events_table table;
+    rc = read_events(file, path, &table, err);
+    bk_stats_report *r = NULL;
+    if (rc == BK_OK) {
+        r = calloc(1, sizeof *r);
+        if (r)
+            r->path = strdup(path);
+        if (!r || !r->path)
+            rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    }
+    if (rc == BK_OK) {
+        r->options = *opt;
+        rc = compute(r, file, &table, err);
+    }
+    events_table_free(&table);
+    CLOSE_IDS(rc, file);
+    if (rc != BK_OK) {
+        bk_stats_report_free(r);
+        return rc;
+    }
+    *out = r;
+    return BK_OK;
+}
+
+void bk_stats_report_free(bk_stats_report *r)
+{
+    if (!r)
+        return;
+    free(r->path);
+    free(r->t_start);
+    free(r->magnitude);
+    free(r->potency);
+    bk_mfd_free(&r->mfd);
+    bk_recurrence_free(&r->recurrence);
+    bk_size_dist_free(&r->sizes);
+    free(r);
+}
