@@ -6,8 +6,8 @@
 #   machine.txt, tables.md, wp_<case>.png (error vs CPU, log-log), scaling.png,
 #   scaling_memory.png, scaling_run_length.tsv and .png
 # Takes about 30 minutes (the scaling part alone 19) on the machine in bench/machine.txt;
-# `scripts/bench.sh --quick` is a smoke run into a temporary directory, `--plot-only` redraws the PNGs and tables from the
-# TSVs in bench/.
+# `scripts/bench.sh --quick` is a smoke run into a temporary directory, `--plot-only`
+# redraws the PNGs and tables from the TSVs in bench/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bench=build/bench/bksim_bench
