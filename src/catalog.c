@@ -7,6 +7,7 @@
 
 #include "bksim/catalog.h"
 #include "bksim/modes.h"
+#include "capacity.h"
 
 struct bk_catalog {
     size_t n;
@@ -81,14 +82,11 @@ static int onset(bk_catalog *c, size_t i, double t, double x, double force)
     c->slipping[i] = 1;
     c->n_slipping++;
     if (c->seen[i] != c->serial) {
-        if (c->n_involved == c->involved_capacity) {
-            size_t cap = c->involved_capacity ? 2 * c->involved_capacity : 64;
-            int32_t *grown = realloc(c->involved, cap * sizeof *grown);
-            if (!grown)
-                return BK_ERR_NOMEM;
-            c->involved = grown;
-            c->involved_capacity = cap;
-        }
+        int32_t *involved = bk_grow_array(c->involved, &c->involved_capacity, c->n_involved + 1,
+                                          sizeof *involved, 64);
+        if (!involved)
+            return BK_ERR_NOMEM;
+        c->involved = involved;
         c->involved[c->n_involved++] = (int32_t)i;
         c->seen[i] = c->serial;
         c->first_force[i] = force;

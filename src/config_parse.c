@@ -18,6 +18,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "capacity.h"
 #include "config_impl.h"
 #include "output/layout.h"
 
@@ -94,14 +95,10 @@ static long split_section(const char *section, char *base, size_t len)
 int bk_config_add_entry(loader *ld, const char *section, const char *key, const char *value, int line,
                         const char *override, long rank)
 {
-    if (ld->n == ld->cap) {
-        size_t cap = ld->cap ? 2 * ld->cap : 32;
-        entry *grown = realloc(ld->entries, cap * sizeof *grown);
-        if (!grown)
-            return -1;
-        ld->entries = grown;
-        ld->cap = cap;
-    }
+    entry *entries = bk_grow_array(ld->entries, &ld->cap, ld->n + 1, sizeof *entries, 32);
+    if (!entries)
+        return -1;
+    ld->entries = entries;
     entry *e = &ld->entries[ld->n];
     memset(e, 0, sizeof *e);
     e->value = strdup(value);

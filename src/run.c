@@ -67,6 +67,20 @@ double bk_run_stop_time(const run_ctx *ctx)
     return t_checkpoint < ctx->t_end ? t_checkpoint : ctx->t_end;
 }
 
+double bk_run_zero_after(run_ctx *ctx, gsl_function *f, double lo, double hi)
+{
+    if (gsl_root_fsolver_set(ctx->brent, f, lo, hi) != GSL_SUCCESS)
+        return hi;
+    for (int iter = 0; iter < 200; ++iter) {
+        if (gsl_root_fsolver_iterate(ctx->brent) != GSL_SUCCESS)
+            break;
+        double a = gsl_root_fsolver_x_lower(ctx->brent), b = gsl_root_fsolver_x_upper(ctx->brent);
+        if (gsl_root_test_interval(a, b, 0.0, 4.0 * DBL_EPSILON) == GSL_SUCCESS)
+            break;
+    }
+    return gsl_root_fsolver_x_upper(ctx->brent);
+}
+
 static double sample_time(const run_ctx *ctx, long k)
 {
     if (ctx->interval <= 0.0)

@@ -6,6 +6,8 @@
 
 #include <stddef.h>
 
+#include <gsl/gsl_roots.h>
+
 #include "bksim/checkpoint.h"
 #include "bksim/run.h"
 #include "bksim/solver.h"
@@ -63,6 +65,7 @@ typedef struct run_ctx {
     bk_solver_counters retired; /* counters of the instances destroyed */
     /* Quiet stuck blocks by failure time (closed form, no integrator). */
     bk_heap quiet;
+    gsl_root_fsolver *brent; /* hidden stops and aging breakaways, one at a time */
     size_t *batch;           /* blocks failing at one instant, scratch */
 
     /* Energy bookkeeping: what finished, and each stuck block's driver-spring energy when its
@@ -115,6 +118,10 @@ int bk_run_report_progress(run_ctx *ctx, double t);
 double bk_run_checkpoint_time(const run_ctx *ctx);
 /* Where every island's integrator stops: the next checkpoint or t_end. */
 double bk_run_stop_time(const run_ctx *ctx);
+/* The zero of f in [lo, hi] (opposite signs at the ends) located by Brent to rounding: the
+ * upper end of the final bracket, past the zero as at a root an integrator reports; hi when
+ * GSL refuses the bracket. */
+double bk_run_zero_after(run_ctx *ctx, gsl_function *f, double lo, double hi);
 
 /* ---- run_islands.c ---- */
 int bk_run_islands_init(run_ctx *ctx);

@@ -17,7 +17,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <gsl/gsl_errno.h>
 #include <gsl/gsl_roots.h>
 
 #include "capacity.h"
@@ -48,7 +47,8 @@ int bk_run_islands_init(run_ctx *ctx)
     if (ctx->idle_budget < 16 * POOL_LARGEST_Y)
         ctx->idle_budget = 16 * POOL_LARGEST_Y;
     ctx->batch = malloc(n * sizeof *ctx->batch);
-    return ctx->batch ? 0 : -1;
+    ctx->brent = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
+    return ctx->batch && ctx->brent ? 0 : -1;
 }
 
 void bk_run_islands_free(run_ctx *ctx)
@@ -70,6 +70,8 @@ void bk_run_islands_free(run_ctx *ctx)
     free(ctx->islands);
     free(ctx->free_ids);
     free(ctx->batch);
+    if (ctx->brent)
+        gsl_root_fsolver_free(ctx->brent);
     bk_heap_free(&ctx->quiet);
     bk_heap_free(&ctx->island_queue);
 }
@@ -529,20 +531,8 @@ static int locate_hidden_stop(run_ctx *ctx, run_island *isl, size_t i, double t_
         *t_stop = f_hi >= 0.0 ? t_root : lo;
         return BK_OK;
     }
-    gsl_root_fsolver *solver = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
-    if (!solver)
-        return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory locating a stop");
-    gsl_root_fsolver_set(solver, &fn, lo, t_root);
-    for (int iter = 0; iter < 200; ++iter) {
-        if (gsl_root_fsolver_iterate(solver) != GSL_SUCCESS)
-            break;
-        double a = gsl_root_fsolver_x_lower(solver), b = gsl_root_fsolver_x_upper(solver);
-        if (gsl_root_test_interval(a, b, 0.0, 4.0 * DBL_EPSILON) == GSL_SUCCESS)
-            break;
-    }
     /* The upper end is past the zero: the state there has s v <= 0, as at a found root. */
-    *t_stop = gsl_root_fsolver_x_upper(solver);
-    gsl_root_fsolver_free(solver);
+    *t_stop = bk_run_zero_after(ctx, &fn, lo, t_root);
     return probe.status;
 }
 

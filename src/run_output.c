@@ -12,6 +12,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "capacity.h"
 #include "output/layout.h"
 #include "run_impl.h"
 
@@ -105,14 +106,11 @@ int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_
         if (rc != BK_OK)
             return rc;
     }
-    if (ctx->n_instant == ctx->instant_capacity) {
-        size_t cap = ctx->instant_capacity ? 2 * ctx->instant_capacity : 16;
-        bk_transition *grown = realloc(ctx->instant, cap * sizeof *grown);
-        if (!grown)
-            return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the transitions of t = %.17g s", t);
-        ctx->instant = grown;
-        ctx->instant_capacity = cap;
-    }
+    bk_transition *instant = bk_grow_array(ctx->instant, &ctx->instant_capacity, ctx->n_instant + 1,
+                                           sizeof *instant, 16);
+    if (!instant)
+        return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the transitions of t = %.17g s", t);
+    ctx->instant = instant;
     ctx->t_instant = t;
     ctx->instant[ctx->n_instant++] = (bk_transition){
         .t = t,

@@ -3,11 +3,7 @@
  * moves (which rebuilds the partition around it and asks again), so the time its force
  * reaches the static threshold is known in closed form; for a law whose threshold ages at
  * rest, the first zero of the margin is bracketed and located by Brent. */
-#include <float.h>
 #include <math.h>
-
-#include <gsl/gsl_errno.h>
-#include <gsl/gsl_roots.h>
 
 #include "run_impl.h"
 
@@ -66,7 +62,7 @@ static double margin_at(double t, void *user)
  * the time the driver needs to load the spring by the threshold, then the crossing is
  * located by Brent.  Aging laws strengthen the contact concavely in time while the driver
  * loads it linearly, so the margin has one falling zero and sampling cannot step over it. */
-static double aging_failure(const run_ctx *ctx, size_t i, double t)
+static double aging_failure(run_ctx *ctx, size_t i, double t)
 {
     aging_margin m = {ctx, i};
     double g0 = margin_at(t, &m);
@@ -89,27 +85,10 @@ static double aging_failure(const run_ctx *ctx, size_t i, double t)
             return INFINITY;
     }
     gsl_function fn = {margin_at, &m};
-    gsl_root_fsolver *solver = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
-    if (!solver)
-        return lo;
-    if (gsl_root_fsolver_set(solver, &fn, lo, hi) != GSL_SUCCESS) {
-        gsl_root_fsolver_free(solver);
-        return hi;
-    }
-    for (int iter = 0; iter < 200; ++iter) {
-        if (gsl_root_fsolver_iterate(solver) != GSL_SUCCESS)
-            break;
-        double a = gsl_root_fsolver_x_lower(solver), c = gsl_root_fsolver_x_upper(solver);
-        if (gsl_root_test_interval(a, c, 0.0, 4.0 * DBL_EPSILON) == GSL_SUCCESS)
-            break;
-    }
-    /* The upper end is past the zero, as at a root an integrator reports. */
-    double failure = gsl_root_fsolver_x_upper(solver);
-    gsl_root_fsolver_free(solver);
-    return failure;
+    return bk_run_zero_after(ctx, &fn, lo, hi);
 }
 
-static double failure_time(const run_ctx *ctx, size_t i, double t)
+static double failure_time(run_ctx *ctx, size_t i, double t)
 {
     if (ctx->model->blocks[i].law->n_state == 0)
         return coulomb_failure(ctx, i, t, bk_scene_static_threshold(&ctx->scene, i));

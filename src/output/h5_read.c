@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "capacity.h"
 #include "output/h5_impl.h"
 
 int bk_h5_open_input(const char *path, hid_t *file, bk_error *err)
@@ -356,16 +357,12 @@ int bk_h5_load_stored_config(hid_t file, const char *path, bk_config **config, b
     char *save = NULL;
     for (char *line = rc == BK_OK && overrides ? strtok_r(overrides, "\n", &save) : NULL; line;
          line = strtok_r(NULL, "\n", &save)) {
-        if (n_over == cap) {
-            size_t grown_cap = cap ? 2 * cap : 16;
-            const char **grown = realloc(list, grown_cap * sizeof *grown);
-            if (!grown) {
-                rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for the stored overrides", path);
-                break;
-            }
-            list = grown;
-            cap = grown_cap;
+        const char **grown = bk_grow_array(list, &cap, n_over + 1, sizeof *grown, 16);
+        if (!grown) {
+            rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for the stored overrides", path);
+            break;
         }
+        list = grown;
         list[n_over++] = line;
     }
     if (rc == BK_OK)

@@ -8,6 +8,7 @@
 #include "bksim/stats.h"
 
 #include <errno.h>
+#include <stddef.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -164,25 +165,26 @@ static int read_events(hid_t file, const char *path, events_table *t, bk_error *
                          path, required[k], names[0] ? names : "none");
             goto done;
         }
-    void *p;
-    if ((rc = read_field(dset, type, path, t->n, "t_start", H5T_NATIVE_DOUBLE, &p, err)) != BK_OK)
-        goto done;
-    t->t_start = p;
-    if ((rc = read_field(dset, type, path, t->n, "magnitude", H5T_NATIVE_DOUBLE, &p, err)) != BK_OK)
-        goto done;
-    t->magnitude = p;
-    if ((rc = read_field(dset, type, path, t->n, "t_end", H5T_NATIVE_DOUBLE, &p, err)) != BK_OK)
-        goto done;
-    t->t_end = p;
-    if ((rc = read_field(dset, type, path, t->n, "potency", H5T_NATIVE_DOUBLE, &p, err)) != BK_OK)
-        goto done;
-    t->potency = p;
-    if ((rc = read_field(dset, type, path, t->n, "n_blocks", H5T_NATIVE_INT32, &p, err)) != BK_OK)
-        goto done;
-    t->n_blocks = p;
-    if ((rc = read_field(dset, type, path, t->n, "complete", H5T_NATIVE_INT8, &p, err)) != BK_OK)
-        goto done;
-    t->complete = p;
+    /* Each column through its own one-member memory type (absent optional ones stay NULL). */
+    const struct {
+        const char *name;
+        hid_t memory_type;
+        size_t offset; /* of the column's pointer in events_table */
+    } columns[] = {
+        {"t_start", H5T_NATIVE_DOUBLE, offsetof(events_table, t_start)},
+        {"magnitude", H5T_NATIVE_DOUBLE, offsetof(events_table, magnitude)},
+        {"t_end", H5T_NATIVE_DOUBLE, offsetof(events_table, t_end)},
+        {"potency", H5T_NATIVE_DOUBLE, offsetof(events_table, potency)},
+        {"n_blocks", H5T_NATIVE_INT32, offsetof(events_table, n_blocks)},
+        {"complete", H5T_NATIVE_INT8, offsetof(events_table, complete)},
+    };
+    for (size_t k = 0; k < sizeof columns / sizeof *columns; ++k) {
+        void *column = NULL;
+        rc = read_field(dset, type, path, t->n, columns[k].name, columns[k].memory_type, &column, err);
+        if (rc != BK_OK)
+            goto done;
+        memcpy((char *)t + columns[k].offset, &column, sizeof column);
+    }
 done:
     CLOSE_IDS(rc, space, type, dset);
     if (rc != BK_OK)

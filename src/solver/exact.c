@@ -69,20 +69,6 @@
 
 static _Thread_local exact_shared *thread_shared;
 
-/* buf if it holds need elements of size bytes, else a buffer that does in its place
- * (contents dropped); NULL when out of memory (buf kept). */
-static void *large_enough(void *buf, size_t *cap, size_t need, size_t size)
-{
-    if (need <= *cap)
-        return buf;
-    void *larger = malloc(need * size);
-    if (!larger)
-        return NULL;
-    free(buf);
-    *cap = need;
-    return larger;
-}
-
 static void shared_release(exact_shared *s)
 {
     if (!s || --s->users > 0)
@@ -117,22 +103,19 @@ static exact_shared *shared_acquire(void)
 int bk_exact_reserve_coupling(exact_backend *eb)
 {
     exact_shared *s = eb->shared;
-    if (eb->n_couplings == s->couplings_cap) {
-        size_t cap = s->couplings_cap ? 2 * s->couplings_cap : 256;
-        coupling *grown = realloc(s->couplings, cap * sizeof *grown);
-        if (!grown)
-            return -1;
-        s->couplings = grown;
-        s->couplings_cap = cap;
-    }
-    eb->couplings = s->couplings;
+    coupling *couplings =
+        bk_grow_array(s->couplings, &s->couplings_cap, eb->n_couplings + 1, sizeof *couplings, 256);
+    if (!couplings)
+        return -1;
+    s->couplings = couplings;
     return 0;
 }
 
 int bk_exact_reserve_work(exact_backend *eb, size_t largest, bk_error *err)
 {
     exact_shared *s = eb->shared;
-    double *modes = large_enough(s->modes, &s->modes_cap, largest * largest + 3 * largest + 1, sizeof *modes);
+    double *modes = bk_grow_array(s->modes, &s->modes_cap, largest * largest + 3 * largest + 1,
+                                  sizeof *modes, 64);
     if (!modes)
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for the modes of %zu pairs",
                        largest);
@@ -143,11 +126,11 @@ int bk_exact_reserve_work(exact_backend *eb, size_t largest, bk_error *err)
 static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roots, bk_error *err)
 {
     exact_shared *s = eb->shared;
-    double *work = large_enough(s->start, &s->start_cap, 5 * n + 1, sizeof *work);
+    double *work = bk_grow_array(s->start, &s->start_cap, 5 * n + 1, sizeof *work, 64);
     if (work)
         s->start = work;
     size_t *indices =
-        work ? large_enough(s->indices, &s->indices_cap, 3 * (p + 1), sizeof *indices) : NULL;
+        work ? bk_grow_array(s->indices, &s->indices_cap, 3 * (p + 1), sizeof *indices, 64) : NULL;
     if (!indices)
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu components", n);
     s->indices = indices;
@@ -160,17 +143,12 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->cluster_of = s->indices;
     eb->local = s->indices + p + 1;
     eb->parent = s->indices + 2 * (p + 1);
-    eb->couplings = s->couplings;
 
     size_t need = 2 * n + 14 * p + 4 * m * p + 2 * m + 1;
-    if (!bk_capacity_fits(need, eb->arena_cap)) {
-        double *grown = malloc(need * sizeof *grown);
-        if (!grown)
-            return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu components", n);
-        free(eb->arena);
-        eb->arena = grown;
-        eb->arena_cap = need;
-    }
+    double *arena = bk_fit_buffer(eb->arena, &eb->arena_cap, need, sizeof *arena);
+    if (!arena)
+        return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu components", n);
+    eb->arena = arena;
     double *a = eb->arena;
     eb->y0 = a, a += n;
     eb->scratch = a, a += n;
@@ -195,15 +173,10 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->qdot0 = a, a += m;
     eb->q_rate = a;
 
-    size_t need_indices = 4 * (p + 1);
-    if (!bk_capacity_fits(need_indices, eb->indices_cap)) {
-        size_t *grown = malloc(need_indices * sizeof *grown);
-        if (!grown)
-            return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu pairs", p);
-        free(eb->indices);
-        eb->indices = grown;
-        eb->indices_cap = need_indices;
-    }
+    size_t *own_indices = bk_fit_buffer(eb->indices, &eb->indices_cap, 4 * (p + 1), sizeof *own_indices);
+    if (!own_indices)
+        return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu pairs", p);
+    eb->indices = own_indices;
     size_t *ix = eb->indices;
     eb->members = ix, ix += p + 1;
     eb->first = ix, ix += p + 1;
@@ -322,7 +295,6 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     /* the shared work space now serves other instances */
     eb->f0 = eb->probe = eb->scale = eb->delta = eb->predicted = eb->work = NULL;
     eb->cluster_of = eb->local = eb->parent = NULL;
-    eb->couplings = NULL;
     if (rc != BK_OK)
         return rc;
 

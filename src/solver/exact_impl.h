@@ -82,8 +82,7 @@ typedef struct exact_backend {
     size_t *cluster_of, *local, *parent; /* p (+1) each, during a start only (shared) */
     size_t *uniform;            /* per cluster: it moves as one (see the top of the file) */
     size_t n_clusters;
-    coupling *couplings;        /* K's entries, during a start only (shared) */
-    size_t n_couplings;
+    size_t n_couplings;         /* K's entries (in the shared work space) */
     double *matrices;           /* S of each cluster (in place), then T = M^(-1/2) U of each */
     size_t matrices_cap;
     double *S, *T;
@@ -108,7 +107,7 @@ typedef struct exact_backend {
 /* exact_matrices.c: the affine forcing at t0 and K, P, Q (from the Jacobian when the problem
  * has one, else one probe per column); the right-hand side checked for finite values. */
 int bk_exact_read_problem(exact_backend *eb, bk_error *err);
-/* exact.c: room for n_couplings + 1 couplings in the shared work space; -1: out of memory. */
+/* exact.c: room for n_couplings + 1 couplings in shared->couplings; -1: out of memory. */
 int bk_exact_reserve_coupling(exact_backend *eb);
 /* exact.c: the shared work copy for a cluster of `largest` pairs into eb->work. */
 int bk_exact_reserve_work(exact_backend *eb, size_t largest, bk_error *err);

@@ -12,7 +12,7 @@ static int add_coupling(exact_backend *eb, size_t row, size_t col, double value)
 {
     if (bk_exact_reserve_coupling(eb) != 0)
         return -1;
-    eb->couplings[eb->n_couplings++] = (coupling){row, col, value};
+    eb->shared->couplings[eb->n_couplings++] = (coupling){row, col, value};
     return 0;
 }
 
@@ -218,7 +218,7 @@ static int read_jacobian(exact_backend *eb, bk_error *err)
         size[k] = fabs(f0[k]);
     }
     for (size_t e = 0; e < eb->n_couplings; ++e) {
-        const coupling *cp = &eb->couplings[e];
+        const coupling *cp = &eb->shared->couplings[e];
         double change = -cp->value * delta[2 * cp->col];
         predicted[2 * cp->row + 1] += change;
         size[2 * cp->row + 1] += fabs(change);

@@ -100,15 +100,11 @@ void bk_exact_state(exact_backend *eb, double t, double *y)
 static int reserve_matrices(exact_backend *eb, size_t total, size_t largest, bk_error *err)
 {
     size_t need = 2 * total + 1;
-    if (!bk_capacity_fits(need, eb->matrices_cap)) {
-        double *grown = malloc(need * sizeof *grown);
-        if (!grown)
-            return BK_FAIL(err, BK_ERR_NOMEM,
-                           "exact stepper: out of memory for the modes of %zu pairs", eb->p);
-        free(eb->matrices);
-        eb->matrices = grown;
-        eb->matrices_cap = need;
-    }
+    double *matrices = bk_fit_buffer(eb->matrices, &eb->matrices_cap, need, sizeof *matrices);
+    if (!matrices)
+        return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for the modes of %zu pairs",
+                       eb->p);
+    eb->matrices = matrices;
     eb->S = eb->matrices;
     eb->T = eb->S + total;
     return bk_exact_reserve_work(eb, largest, err);
@@ -152,7 +148,7 @@ static int split_clusters(exact_backend *eb, bk_error *err)
     for (size_t i = 0; i < p; ++i)
         parent[i] = i;
     for (size_t e = 0; e < eb->n_couplings; ++e) {
-        size_t a = find_set(parent, eb->couplings[e].row), b = find_set(parent, eb->couplings[e].col);
+        size_t a = find_set(parent, eb->shared->couplings[e].row), b = find_set(parent, eb->shared->couplings[e].col);
         if (a < b)
             parent[b] = a;
         else if (b < a)
@@ -188,7 +184,7 @@ static int split_clusters(exact_backend *eb, bk_error *err)
     for (size_t i = 0; i < p; ++i)
         eb->row_sum[i] = eb->row_scale[i] = 0.0;
     for (size_t e = 0; e < eb->n_couplings; ++e) {
-        const coupling *cp = &eb->couplings[e];
+        const coupling *cp = &eb->shared->couplings[e];
         eb->row_sum[cp->row] += cp->value;
         eb->row_scale[cp->row] = fmax(eb->row_scale[cp->row], fabs(cp->value));
     }
@@ -209,7 +205,7 @@ static int split_clusters(exact_backend *eb, bk_error *err)
         return rc;
     memset(eb->S, 0, total * sizeof *eb->S);
     for (size_t e = 0; e < eb->n_couplings; ++e) {
-        const coupling *cp = &eb->couplings[e];
+        const coupling *cp = &eb->shared->couplings[e];
         size_t k = eb->cluster_of[cp->row], size = eb->first[k + 1] - eb->first[k];
         if (!eb->uniform[k])
             eb->S[eb->offset[k] + eb->local[cp->row] * size + eb->local[cp->col]] += cp->value;
