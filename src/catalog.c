@@ -67,7 +67,7 @@ void bk_catalog_free(bk_catalog *c)
     free(c);
 }
 
-static int onset(bk_catalog *c, size_t i, double t, double x, double force)
+static int onset(bk_catalog *c, size_t i, double t, double x, double v, double force)
 {
     if (!c->open) {
         c->open = 1;
@@ -78,6 +78,8 @@ static int onset(bk_catalog *c, size_t i, double t, double x, double force)
         c->event.first_block = (int32_t)i; /* simultaneous first onsets: the lowest index */
     }
     c->pending = 0;
+    if (fabs(v) > c->event.max_slip_rate)
+        c->event.max_slip_rate = fabs(v);
     c->x_onset[i] = x;
     c->slipping[i] = 1;
     c->n_slipping++;
@@ -134,23 +136,23 @@ static void close_event(bk_catalog *c, double t_end, bk_event *out)
     bk_event *e = &c->event;
     e->t_end = t_end;
     e->n_blocks = (int32_t)c->n_involved;
+    extent(c, e); /* sorts the blocks: the sum below goes in block order, as after a restore */
     double drop = 0.0;
     for (size_t j = 0; j < c->n_involved; ++j)
         drop += c->first_force[c->involved[j]] - c->last_force[c->involved[j]];
     e->stress_drop = drop / (double)c->n_involved;
     e->magnitude = e->potency > 0.0 ? 2.0 / 3.0 * log10(e->potency) + c->magnitude_offset : -INFINITY;
-    extent(c, e);
     *out = *e;
     c->open = 0;
     c->pending = 0;
 }
 
-int bk_catalog_begin(bk_catalog *c, double t, const int8_t *mode, const double *x,
+int bk_catalog_begin(bk_catalog *c, double t, const int8_t *mode, const double *x, const double *v,
                      bk_catalog_force_fn force, const void *user)
 {
     for (size_t i = 0; i < c->n; ++i)
         if (mode[i] != BK_MODE_STICK) {
-            int rc = onset(c, i, t, x[i], force(user, i));
+            int rc = onset(c, i, t, x[i], v ? v[i] : 0.0, force(user, i));
             if (rc != BK_OK)
                 return rc;
         }
@@ -169,7 +171,7 @@ int bk_catalog_add(bk_catalog *c, const bk_transition *tr, bk_event *event, int 
     size_t i = (size_t)tr->block;
     int slips = tr->to != BK_MODE_STICK;
     if (!c->slipping[i] && slips)
-        return onset(c, i, tr->t, tr->x, tr->force);
+        return onset(c, i, tr->t, tr->x, tr->v, tr->force);
     if (c->slipping[i] && !slips) {
         episode_end(c, i, tr->x, tr->force);
         c->slipping[i] = 0;
@@ -202,4 +204,78 @@ int bk_catalog_finish(bk_catalog *c, double t, const double *x, bk_catalog_force
     close_event(c, t, event);
     event->complete = 0;
     return 1;
+}
+
+void bk_catalog_slip_rate(bk_catalog *c, double slip_rate)
+{
+    if (c->open && !c->pending && fabs(slip_rate) > c->event.max_slip_rate)
+        c->event.max_slip_rate = fabs(slip_rate);
+}
+
+double bk_catalog_max_slip_rate(const bk_catalog *c)
+{
+    return c->open && !c->pending ? c->event.max_slip_rate : -1.0;
+}
+
+void bk_catalog_save(const bk_catalog *c, bk_catalog_state *s)
+{
+    for (size_t i = 0; i < c->n; ++i) {
+        int in_event = c->open && c->seen[i] == c->serial;
+        s->involved[i] = (uint8_t)in_event;
+        s->slipping[i] = (uint8_t)c->slipping[i];
+        /* Only what the open event uses: the rest is stale and would make the saved state
+         * depend on history a resumed run never sees. */
+        s->x_onset[i] = c->slipping[i] ? c->x_onset[i] : 0.0;
+        s->first_force[i] = in_event ? c->first_force[i] : 0.0;
+        s->last_force[i] = in_event ? c->last_force[i] : 0.0;
+    }
+    s->open = c->open;
+    s->pending = c->pending;
+    s->t_pending = c->pending ? c->t_pending : 0.0;
+    s->t_start = c->open ? c->event.t_start : 0.0;
+    s->first_block = c->open ? c->event.first_block : -1;
+    s->n_episodes = c->open ? c->event.n_episodes : 0;
+    s->potency = c->open ? c->event.potency : 0.0;
+    s->max_slip_rate = c->open ? c->event.max_slip_rate : 0.0;
+}
+
+int bk_catalog_restore(bk_catalog *c, const bk_catalog_state *s)
+{
+    size_t involved = 0, slipping = 0;
+    for (size_t i = 0; i < c->n; ++i) {
+        if (s->slipping[i] > 1 || s->involved[i] > 1 || (s->slipping[i] && !s->involved[i]))
+            return BK_ERR_INVALID;
+        involved += s->involved[i];
+        slipping += s->slipping[i];
+    }
+    if (!s->open != !involved || (s->pending && slipping > 0) || (!s->pending && s->open && slipping == 0) ||
+        (s->open && (s->first_block < 0 || (size_t)s->first_block >= c->n)))
+        return BK_ERR_INVALID;
+    int32_t *list = bk_grow_array(c->involved, &c->involved_capacity, involved ? involved : 1,
+                                  sizeof *list, 64);
+    if (!list)
+        return BK_ERR_NOMEM;
+    c->involved = list;
+    c->serial++;
+    c->n_involved = 0;
+    c->n_slipping = slipping;
+    for (size_t i = 0; i < c->n; ++i) {
+        c->slipping[i] = (int8_t)s->slipping[i];
+        c->x_onset[i] = s->x_onset[i];
+        c->first_force[i] = s->first_force[i];
+        c->last_force[i] = s->last_force[i];
+        c->seen[i] = s->involved[i] ? c->serial : -1;
+        if (s->involved[i])
+            c->involved[c->n_involved++] = (int32_t)i;
+    }
+    c->open = s->open != 0;
+    c->pending = s->pending != 0;
+    c->t_pending = s->t_pending;
+    c->event = (bk_event){.t_start = s->t_start,
+                          .first_block = (int32_t)s->first_block,
+                          .n_episodes = (int32_t)s->n_episodes,
+                          .potency = s->potency,
+                          .max_slip_rate = s->max_slip_rate,
+                          .complete = 1};
+    return BK_OK;
 }

@@ -2,13 +2,19 @@
  * Nothing here knows HDF5; src/output/h5_checkpoint.c frames the table into file slots. */
 #include "bksim/checkpoint.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define ARRAY(name, member, type, extent) \
-    {name, BK_CHECKPOINT_##type, BK_CHECKPOINT_##extent, offsetof(bk_checkpoint, member)}
+    {name, 0, BK_CHECKPOINT_##type, BK_CHECKPOINT_##extent, offsetof(bk_checkpoint, member)}
 #define SCALAR(member, type) \
-    {#member, BK_CHECKPOINT_##type, BK_CHECKPOINT_SCALAR, offsetof(bk_checkpoint, member)}
+    {#member, 0, BK_CHECKPOINT_##type, BK_CHECKPOINT_SCALAR, offsetof(bk_checkpoint, member)}
+/* The catalog builder's state: after the rest, so files without it hash as before. */
+#define CATALOG_ARRAY(member, type) \
+    {"catalog_" #member, 1, BK_CHECKPOINT_##type, BK_CHECKPOINT_PER_BLOCK, offsetof(bk_catalog_state, member)}
+#define CATALOG_SCALAR(member, type) \
+    {"catalog_" #member, 1, BK_CHECKPOINT_##type, BK_CHECKPOINT_SCALAR, offsetof(bk_catalog_state, member)}
 
 const bk_checkpoint_field bk_checkpoint_fields[] = {
     ARRAY("mode", mode, I8, PER_BLOCK),
@@ -28,11 +34,27 @@ const bk_checkpoint_field bk_checkpoint_fields[] = {
     SCALAR(t_last_row, F64),
     SCALAR(next_sample, LONG),
     SCALAR(steps_since_row, LONG),
+    CATALOG_ARRAY(x_onset, F64),
+    CATALOG_ARRAY(first_force, F64),
+    CATALOG_ARRAY(last_force, F64),
+    CATALOG_ARRAY(involved, U8),
+    CATALOG_ARRAY(slipping, U8),
+    CATALOG_SCALAR(open, LONG),
+    CATALOG_SCALAR(pending, LONG),
+    CATALOG_SCALAR(t_pending, F64),
+    CATALOG_SCALAR(t_start, F64),
+    CATALOG_SCALAR(first_block, LONG),
+    CATALOG_SCALAR(n_episodes, LONG),
+    CATALOG_SCALAR(potency, F64),
+    CATALOG_SCALAR(max_slip_rate, F64),
+    CATALOG_SCALAR(events, LONG),
 };
 const size_t bk_checkpoint_n_fields = sizeof bk_checkpoint_fields / sizeof bk_checkpoint_fields[0];
 
 #undef ARRAY
 #undef SCALAR
+#undef CATALOG_ARRAY
+#undef CATALOG_SCALAR
 
 #define STAT_L(member, units) {#member, 1, offsetof(bk_run_stats, member), units}
 #define STAT_D(member, units) {#member, 0, offsetof(bk_run_stats, member), units}
@@ -68,6 +90,8 @@ size_t bk_checkpoint_type_size(bk_checkpoint_type type)
 
 size_t bk_checkpoint_field_count(const bk_checkpoint_field *field, const bk_checkpoint *cp)
 {
+    if (!bk_checkpoint_field_present(field, cp))
+        return 0;
     switch (field->extent) {
     case BK_CHECKPOINT_PER_BLOCK:
         return cp->n_blocks;
@@ -79,19 +103,27 @@ size_t bk_checkpoint_field_count(const bk_checkpoint_field *field, const bk_chec
     return 1;
 }
 
+int bk_checkpoint_field_present(const bk_checkpoint_field *field, const bk_checkpoint *cp)
+{
+    return !field->catalog || cp->catalog != NULL;
+}
+
+/* The struct a field is a member of. */
+static char *field_base(const bk_checkpoint_field *field, const bk_checkpoint *cp)
+{
+    return field->catalog ? (char *)cp->catalog : (char *)(uintptr_t)cp;
+}
+
 const void *bk_checkpoint_field_cdata(const bk_checkpoint_field *field, const bk_checkpoint *cp)
 {
-    const char *member = (const char *)cp + field->offset;
-    if (field->extent == BK_CHECKPOINT_SCALAR)
-        return member;
-    const void *array;
-    memcpy(&array, member, sizeof array);
-    return array;
+    return bk_checkpoint_field_data(field, (bk_checkpoint *)(uintptr_t)cp);
 }
 
 void *bk_checkpoint_field_data(const bk_checkpoint_field *field, bk_checkpoint *cp)
 {
-    char *member = (char *)cp + field->offset;
+    if (!bk_checkpoint_field_present(field, cp))
+        return NULL;
+    char *member = field_base(field, cp) + field->offset;
     if (field->extent == BK_CHECKPOINT_SCALAR)
         return member;
     void *array;
@@ -99,19 +131,17 @@ void *bk_checkpoint_field_data(const bk_checkpoint_field *field, bk_checkpoint *
     return array;
 }
 
-int bk_checkpoint_alloc(bk_checkpoint *cp, size_t n_blocks, size_t n_state)
+/* The arrays of one part (0: the checkpoint, 1: its catalog). */
+static int alloc_arrays(bk_checkpoint *cp, int catalog)
 {
-    memset(cp, 0, sizeof *cp);
-    cp->n_blocks = n_blocks;
-    cp->n_state = n_state;
     for (size_t k = 0; k < bk_checkpoint_n_fields; ++k) {
         const bk_checkpoint_field *f = &bk_checkpoint_fields[k];
-        if (f->extent == BK_CHECKPOINT_SCALAR)
+        if (f->extent == BK_CHECKPOINT_SCALAR || f->catalog != catalog)
             continue;
         size_t count = bk_checkpoint_field_count(f, cp);
         /* At least one element, so a chain without friction states still gets a pointer. */
         void *array = calloc(count ? count : 1, bk_checkpoint_type_size(f->type));
-        memcpy((char *)cp + f->offset, &array, sizeof array);
+        memcpy(field_base(f, cp) + f->offset, &array, sizeof array);
         if (!array) {
             bk_checkpoint_free(cp);
             return BK_ERR_NOMEM;
@@ -120,11 +150,32 @@ int bk_checkpoint_alloc(bk_checkpoint *cp, size_t n_blocks, size_t n_state)
     return BK_OK;
 }
 
+int bk_checkpoint_alloc(bk_checkpoint *cp, size_t n_blocks, size_t n_state)
+{
+    memset(cp, 0, sizeof *cp);
+    cp->n_blocks = n_blocks;
+    cp->n_state = n_state;
+    return alloc_arrays(cp, 0);
+}
+
+int bk_checkpoint_alloc_catalog(bk_checkpoint *cp)
+{
+    if (cp->catalog)
+        return BK_OK;
+    cp->catalog = calloc(1, sizeof *cp->catalog);
+    if (!cp->catalog) {
+        bk_checkpoint_free(cp);
+        return BK_ERR_NOMEM;
+    }
+    return alloc_arrays(cp, 1);
+}
+
 void bk_checkpoint_free(bk_checkpoint *cp)
 {
     for (size_t k = 0; k < bk_checkpoint_n_fields; ++k)
         if (bk_checkpoint_fields[k].extent != BK_CHECKPOINT_SCALAR)
             free(bk_checkpoint_field_data(&bk_checkpoint_fields[k], cp));
+    free(cp->catalog);
     memset(cp, 0, sizeof *cp);
 }
 
@@ -191,6 +242,8 @@ uint64_t bk_checkpoint_hash(const bk_checkpoint *cp, const bk_checkpoint_record 
     h = hash_u64(h, (uint64_t)cp->n_state);
     for (size_t k = 0; k < bk_checkpoint_n_fields; ++k) {
         const bk_checkpoint_field *f = &bk_checkpoint_fields[k];
+        if (!bk_checkpoint_field_present(f, cp))
+            continue;
         const void *data = bk_checkpoint_field_cdata(f, cp);
         if (f->extent != BK_CHECKPOINT_SCALAR) {
             h = hash_bytes(h, data, bk_checkpoint_field_count(f, cp) * bk_checkpoint_type_size(f->type));

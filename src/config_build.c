@@ -360,6 +360,39 @@ static int has_section(loader *ld, const char *section)
     return 0;
 }
 
+/* [output] events and [catalog]: the catalog needs a notion of slipping for every block. */
+static void build_catalog(loader *ld, bk_config *c)
+{
+    bk_output_options *o = &c->output;
+    o->events = (int)value_of(ld, "output", "events");
+    c->catalog.magnitude_offset = value_of(ld, "catalog", "magnitude_offset");
+    c->catalog.slip_rate_threshold = value_of(ld, "catalog", "slip_rate_threshold");
+    entry *events = bk_config_lookup(ld, "output", "events");
+    entry *threshold = bk_config_lookup(ld, "catalog", "slip_rate_threshold");
+    if (c->prescribed) {
+        if (events && o->events)
+            bk_config_report_entry(ld, events, "a prescribed scene has no slip events (allowed: false)");
+        o->events = 0;
+        return;
+    }
+    if (!c->model || ld->error_rank != LONG_MAX)
+        return;
+    size_t creeping = c->model->n_blocks;
+    for (size_t i = 0; i < c->model->n_blocks && creeping == c->model->n_blocks; ++i)
+        if (!(c->model->blocks[i].law->flags & BK_FRICTION_STATIC_THRESHOLD))
+            creeping = i;
+    if (threshold && creeping == c->model->n_blocks)
+        bk_config_report_entry(ld, threshold, "applies to laws without a stuck state (dieterich_ruina_aging, "
+                               "dieterich_ruina_slip); every block here sticks, and slips when it does not "
+                               "(allowed: remove the key)");
+    else if (o->events && !threshold && creeping < c->model->n_blocks)
+        bk_config_report(ld, RANK_MISSING, BK_ERR_CONFIG,
+                         "%s: [catalog] slip_rate_threshold: required for the event catalog, as block %zu's law "
+                         "%s never sticks (allowed: a slip rate > 0 m/s well above the creep rate and below "
+                         "the slip rates of events, e.g. 1e-3 m/s; or [output] events = false)",
+                         ld->name, creeping, c->model->blocks[creeping].law->name);
+}
+
 /* Everything checked: build the config.  Reports missing and cross-key errors. */
 bk_config *bk_config_build(loader *ld)
 {
@@ -403,6 +436,7 @@ bk_config *bk_config_build(loader *ld)
     if (c->prescribed)
         o->fields &= ~(unsigned)BK_FIELD_ENERGY; /* no dynamics, no energies */
     o->transitions = (int)value_of(ld, "output", "transitions");
+    build_catalog(ld, c);
     double event_rows = value_of(ld, "output", "event_rows");
     o->event_rows = isnan(event_rows) ? c->model && c->model->n_blocks <= BK_EVENT_ROWS_AUTO_BLOCKS
                                       : (int)event_rows;

@@ -113,6 +113,9 @@ static const key_def keys[] = {
     {"output", {"fields", "", 0, 0, 0, 0, "per-row datasets: all, or a list of x v friction cof mode energy state"},
      BK_KEY_FIELDS, bk_output_field_names, NULL, "all"},
     {"output", {"transitions", "", 1, 0, 1, 0, "write the /transitions table"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
+    {"output", {"events", "", 1, 0, 1, 0,
+                "build the event catalog during the run and write the /events table (README \"Earthquake catalogs and statistics\")"},
+     BK_KEY_BOOLEAN, NULL, NULL, "true"},
     {"output", {"event_rows", "", NAN, 0, 1, 0,
                 "add a full row at every transition instant (an O(n_blocks) snapshot per event; the "
                 "/transitions table holds the changed block's state anyway); auto: true up to 16 blocks"},
@@ -125,6 +128,13 @@ static const key_def keys[] = {
         "largest number of sample rows (t_end / interval) a run may write: a guard against a typo in interval"),
     NUM("output", "checkpoint_interval", "s", 0.0, 0.0, INFINITY, 0,
         "time between checkpoints, from which `bksim run --restart` continues (0: none)"),
+
+    NUM("catalog", "magnitude_offset", "1", 0.0, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
+        "added to every magnitude (2/3) log10(potency / 1 m): differences are moment-magnitude differences"),
+    {"catalog", {"slip_rate_threshold", "m/s", NAN, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
+                 "for laws without a stuck state (dieterich_ruina_*): a block slips, for the catalog, while its "
+                 "|slip rate| exceeds this; required for such laws when events are on"},
+     BK_KEY_NUMBER, NULL, NULL, "none"},
 
     NUM("run", "t_end", "s", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE,
         "end time (runs from 0); in a prescribed scene optional, at most the schedule's length"),
@@ -140,8 +150,8 @@ static const key_def keys[] = {
 };
 #define N_KEYS (sizeof keys / sizeof keys[0])
 
-const char *const bk_config_sections[] = {"model", "block", "friction", "driver", "solver", "output", "run",
-                                          "prescribed", NULL};
+const char *const bk_config_sections[] = {"model", "block", "friction", "driver", "solver", "output", "catalog",
+                                          "run", "prescribed", NULL};
 
 int bk_config_key(size_t i, bk_key_info *info)
 {
@@ -242,6 +252,7 @@ void bk_config_write_reference(FILE *out)
         "driver", "The driver that pulls every block through its driver spring.",
         "solver", "Integration.",
         "output", "The HDF5 file.",
+        "catalog", "The event catalog (/events): an event is a maximal interval during which some block slips.",
         "run", "The time span.",
         "prescribed", "A prescribed-motion scene instead of the chain's dynamics (paper Figure 2, slide-hold-slide): "
                       "one block slides at a piecewise-constant slip rate and its friction state follows the law's "

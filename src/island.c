@@ -166,7 +166,10 @@ void bk_island_restart(bk_island *island, double t, double *y)
             if (ns > max_state)
                 max_state = ns;
         }
-        island->root_direction[R * k + BK_ROOT_MAIN] = scene->can_stick[i] ? -1 : 0;
+        island->root_direction[R * k + BK_ROOT_MAIN] = scene->can_stick[i]        ? -1
+                                                        : !scene->above     ? 0
+                                                        : scene->above[i]   ? -1
+                                                                            : +1;
         island->root_direction[R * k + BK_ROOT_EXTREMUM] = dir != 0 && scene->can_stick[i] ? +1 : 0;
         if (R > 2)
             island->root_direction[R * k + BK_ROOT_SLACK] = 0;
@@ -431,7 +434,8 @@ int bk_island_roots(double t, const double *y, double *g, void *user)
         const double *state = block_state(island, y, i);
         size_t s = scene->slot[i];
         if (!scene->can_stick[i]) {
-            gi[BK_ROOT_MAIN] = 1.0; /* smooth through v = 0: nothing to locate */
+            /* Smooth through v = 0: only the catalog's threshold to locate, if any. */
+            gi[BK_ROOT_MAIN] = scene->slip_threshold > 0.0 ? fabs(y[s + 1]) - scene->slip_threshold : 1.0;
             gi[BK_ROOT_EXTREMUM] = 1.0;
         } else if (bk_scene_stuck(scene, i)) {
             gi[BK_ROOT_MAIN] = b->law->static_threshold(b->friction_params, scene->normal[i], state) -

@@ -240,6 +240,7 @@ static void resolve_scales(run_ctx *ctx)
 
 static void free_ctx(run_ctx *ctx)
 {
+    bk_run_catalog_free(ctx);
     bk_run_islands_free(ctx);
     bk_scene_free(&ctx->scene);
     free(ctx->spring_energy_ref);
@@ -350,6 +351,8 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
         ctx.last_transition[i] = -INFINITY;
     /* Scales come from the initial state in a resumed run too, so both runs use the same. */
     resolve_scales(&ctx);
+    if ((rc = bk_run_catalog_init(&ctx, from)) != BK_OK)
+        goto done;
 
     if (from) {
         if ((rc = bk_run_resume(&ctx, from)) != BK_OK || (rc = bk_run_partition_all(&ctx, from->t)) != BK_OK)
@@ -370,6 +373,8 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
     rc = schedule(&ctx);
     if (rc == BK_OK)
         rc = close_instant(&ctx);
+    if (rc == BK_OK)
+        rc = bk_run_catalog_finish(&ctx, ctx.t_end);
 
 done:
     bk_run_collect_stats(&ctx, ctx.stats, (double)cpu0);

@@ -8,6 +8,7 @@
 
 #include <gsl/gsl_roots.h>
 
+#include "bksim/catalog.h"
 #include "bksim/checkpoint.h"
 #include "bksim/run.h"
 #include "bksim/solver.h"
@@ -108,6 +109,14 @@ typedef struct run_ctx {
     double checkpoint_interval;
     long next_checkpoint; /* index k of the next checkpoint time k * interval */
     bk_run_stats base;    /* counters of the run this one resumed, if any */
+
+    /* The event catalog (run_catalog.c); NULL when the run keeps none. */
+    bk_catalog *catalog;
+    long events;          /* events completed */
+    double t_catalog;     /* s, where the builder's force callback evaluates */
+    double *rate_v, *rate_a; /* per block: v and d|v|/dt at its island's last step end */
+    int8_t *catalog_modes;   /* scratch: the modes the builder begins with */
+    bk_catalog_state catalog_state; /* what a checkpoint saves (arrays only with checkpoints) */
 } run_ctx;
 
 /* ---- run.c ---- */
@@ -147,7 +156,26 @@ int bk_run_unpack_all(run_ctx *ctx, double t);
 /* Counters of every back-end instance so far. */
 void bk_run_solver_counters(const run_ctx *ctx, bk_solver_counters *total);
 
+/* ---- run_catalog.c ---- */
+/* The builder, begun at t = 0 from the chain's arrays or restored from a checkpoint (none
+ * when [output] events is off, or the checkpoint predates catalogs). */
+int bk_run_catalog_init(run_ctx *ctx, const bk_checkpoint *from);
+void bk_run_catalog_free(run_ctx *ctx);
+/* A transition, as it happens; a completed event goes to the sink. */
+int bk_run_catalog_transition(run_ctx *ctx, const bk_transition *transition);
+/* Block i (a law without a stuck state, unpacked at t) crosses the slip-rate threshold. */
+int bk_run_catalog_crossing(run_ctx *ctx, double t, size_t i);
+/* The end of the run at t (the chain's arrays unpacked there): the last event. */
+int bk_run_catalog_finish(run_ctx *ctx, double t);
+/* The builder's state for a checkpoint; NULL without a catalog. */
+bk_catalog_state *bk_run_catalog_save(run_ctx *ctx);
+/* Slip rates of an island just (re)started, and of its last step (maxima inside it too). */
+void bk_run_catalog_island_start(run_ctx *ctx, const run_island *isl);
+int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl);
+
 /* ---- run_output.c ---- */
+/* Count bytes written (rows, transitions, events) against [output] max_bytes at t. */
+int bk_run_count_bytes(run_ctx *ctx, double bytes, double t);
 /* A row from the chain's arrays at t (bk_run_unpack_all first). */
 int bk_run_emit_row(run_ctx *ctx, double t, int is_event);
 /* A mode change of block i at t with the applied force then: chattering guard, statistics,

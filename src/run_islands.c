@@ -282,6 +282,7 @@ static int start_island(run_ctx *ctx, size_t id, double t)
     isl->stepped = 0;
     isl->pending = 0;
     isl->t_reached = t;
+    bk_run_catalog_island_start(ctx, isl);
     bk_heap_set(&ctx->island_queue, id, t);
     return BK_OK;
 }
@@ -633,6 +634,8 @@ int bk_run_island_step(run_ctx *ctx, size_t id)
     }
     if (rc != BK_OK)
         return rc;
+    if ((rc = bk_run_catalog_island_step(ctx, isl)) != BK_OK)
+        return rc;
     bk_heap_set(&ctx->island_queue, id, island_key(isl));
     /* Every step, so that a wall-clock limit bites inside long segments. */
     return bk_run_report_progress(ctx, t_reached);
@@ -690,6 +693,11 @@ int bk_run_island_event(run_ctx *ctx, size_t id)
         int fired = i == isl->hidden_block || (!rewound && isl->found[R * k + BK_ROOT_MAIN] != 0);
         if (!fired)
             continue;
+        if (!scene->can_stick[i]) {
+            if ((rc = bk_run_catalog_crossing(ctx, t, i)) != BK_OK)
+                return rc;
+            continue;
+        }
         bk_mode_event event = bk_scene_stuck(scene, i) ? BK_EVENT_BREAKAWAY : BK_EVENT_STOP;
         rc = bk_run_apply_event(ctx, t, i, event);
         if (rc < 0)

@@ -18,17 +18,17 @@
 
 /* The [output] max_bytes guard counts what is written, event rows and transitions too:
  * their number is not known before the run. */
-static int count_bytes(run_ctx *ctx, double bytes, double t)
+int bk_run_count_bytes(run_ctx *ctx, double bytes, double t)
 {
     ctx->bytes_written += bytes;
     if (ctx->bytes_written <= ctx->max_bytes)
         return BK_OK;
     return BK_FAIL(ctx->err, BK_ERR_LIMIT,
-                   "[output] max_bytes = %.3g B reached at t = %.17g s: %ld rows of %.3g B and %ld "
-                   "transitions of %d B; raise max_bytes, sample less often, or write no event rows "
-                   "([output] event_rows = false)",
+                   "[output] max_bytes = %.3g B reached at t = %.17g s: %ld rows of %.3g B, %ld "
+                   "transitions of %d B and %ld events of %d B; raise max_bytes, sample less often, or "
+                   "write no event rows ([output] event_rows = false)",
                    ctx->max_bytes, t, ctx->stats->rows, ctx->row_bytes, ctx->stats->transitions,
-                   BK_TRANSITION_RECORD_BYTES);
+                   BK_TRANSITION_RECORD_BYTES, ctx->events, BK_EVENT_RECORD_BYTES);
 }
 
 int bk_run_emit_row(run_ctx *ctx, double t, int is_event)
@@ -67,7 +67,7 @@ int bk_run_emit_row(run_ctx *ctx, double t, int is_event)
     ctx->t_last_row = t;
     ctx->steps_since_row = 0;
     ctx->stats->rows++;
-    if ((rc = count_bytes(ctx, ctx->row_bytes, t)) != BK_OK)
+    if ((rc = bk_run_count_bytes(ctx, ctx->row_bytes, t)) != BK_OK)
         return rc;
     if (ctx->sink && ctx->sink->sample) {
         rc = ctx->sink->sample(ctx->sink->self, &sample, ctx->err);
@@ -75,6 +75,11 @@ int bk_run_emit_row(run_ctx *ctx, double t, int is_event)
             return rc < 0 ? rc : BK_ERR_SINK;
     }
     return BK_OK;
+}
+
+static int writes_transitions(const run_ctx *ctx)
+{
+    return ctx->config->output.transitions && ctx->sink && ctx->sink->transition;
 }
 
 int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_mode to,
@@ -96,23 +101,7 @@ int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_
                        bk_scene_static_threshold(scene, i));
     ctx->stats->transitions++;
     ctx->steps_since_row = 0;
-    if (!ctx->config->output.transitions || !ctx->sink || !ctx->sink->transition)
-        return BK_OK;
-    int limit = count_bytes(ctx, BK_TRANSITION_RECORD_BYTES, t);
-    if (limit != BK_OK)
-        return limit;
-    if (ctx->n_instant > 0 && t != ctx->t_instant) {
-        int rc = bk_run_flush_instant(ctx);
-        if (rc != BK_OK)
-            return rc;
-    }
-    bk_transition *instant = bk_grow_array(ctx->instant, &ctx->instant_capacity, ctx->n_instant + 1,
-                                           sizeof *instant, 16);
-    if (!instant)
-        return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the transitions of t = %.17g s", t);
-    ctx->instant = instant;
-    ctx->t_instant = t;
-    ctx->instant[ctx->n_instant++] = (bk_transition){
+    bk_transition record = {
         .t = t,
         .block = (int32_t)i,
         .from = (int8_t)from,
@@ -121,6 +110,23 @@ int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_
         .v = scene->v[i],
         .force = applied_force,
     };
+    /* The catalog takes them in the order /transitions holds them, so that it is the
+     * catalog rebuilt from that table bit for bit. */
+    int written = writes_transitions(ctx);
+    if (!written && !ctx->catalog)
+        return BK_OK;
+    int rc = written ? bk_run_count_bytes(ctx, BK_TRANSITION_RECORD_BYTES, t) : BK_OK;
+    if (rc != BK_OK)
+        return rc;
+    if (ctx->n_instant > 0 && t != ctx->t_instant && (rc = bk_run_flush_instant(ctx)) != BK_OK)
+        return rc;
+    bk_transition *instant = bk_grow_array(ctx->instant, &ctx->instant_capacity, ctx->n_instant + 1,
+                                           sizeof *instant, 16);
+    if (!instant)
+        return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the transitions of t = %.17g s", t);
+    ctx->instant = instant;
+    ctx->t_instant = t;
+    ctx->instant[ctx->n_instant++] = record;
     return BK_OK;
 }
 
@@ -137,8 +143,11 @@ int bk_run_flush_instant(run_ctx *ctx)
             ctx->instant[j] = ctx->instant[j - 1];
         ctx->instant[j] = moving;
     }
+    int written = writes_transitions(ctx);
     for (size_t k = 0; k < n; ++k) {
-        int rc = ctx->sink->transition(ctx->sink->self, &ctx->instant[k], ctx->err);
+        int rc = bk_run_catalog_transition(ctx, &ctx->instant[k]);
+        if (rc == BK_OK && written)
+            rc = ctx->sink->transition(ctx->sink->self, &ctx->instant[k], ctx->err);
         if (rc != BK_OK)
             return rc < 0 ? rc : BK_ERR_SINK;
     }
@@ -226,6 +235,7 @@ int bk_run_checkpoint(run_ctx *ctx, double t)
             .kinetic_initial = ctx->kinetic0,
             .t_last_row = ctx->t_last_row,
             .steps_since_row = ctx->steps_since_row,
+            .catalog = bk_run_catalog_save(ctx),
         };
         cp.stats = *ctx->stats;
         bk_run_collect_stats(ctx, &cp.stats, ctx->cpu0);

@@ -67,6 +67,9 @@ typedef struct bk_scene {
     long *left, *right;      /* coupling partners (bk_model_neighbours) */
     size_t roots_per_block;  /* 2, or 3 with tension-only springs */
     size_t max_block_state;  /* friction states of the most stateful block */
+    double slip_threshold;   /* m/s: the event catalog's slip rate for laws without a stuck
+                                state (0: none; then their roots stay silent) */
+    uint8_t *above;          /* per block of such a law: |v| above slip_threshold (NULL: none) */
 } bk_scene;
 
 int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema);

@@ -127,7 +127,7 @@ static void test_begin_and_finish(void **state)
     bk_catalog *c = bk_catalog_create(4, 0, 0.0);
     const int8_t mode[4] = {STICK, SLIP, SLIP, STICK};
     const double x0[4] = {0.0, 0.5, 0.7, 0.0}, f0[4] = {0.0, 6.0, 6.5, 0.0};
-    assert_int_equal(bk_catalog_begin(c, 0.0, mode, x0, from_array, f0), BK_OK);
+    assert_int_equal(bk_catalog_begin(c, 0.0, mode, x0, NULL, from_array, f0), BK_OK);
     const bk_transition list[] = {tr(0.5, 1, SLIP, STICK, 0.6, 5.0)};
     bk_event e;
     assert_int_equal(feed(c, list, 1, &e), 0);

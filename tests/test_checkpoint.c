@@ -36,12 +36,18 @@ static void test_every_checkpoint_member_described(void **state)
 {
     (void)state;
     unsigned char covered[sizeof(bk_checkpoint)] = {0};
+    unsigned char covered_catalog[sizeof(bk_catalog_state)] = {0};
     for (size_t k = 0; k < bk_checkpoint_n_fields; ++k) {
         const bk_checkpoint_field *f = &bk_checkpoint_fields[k];
         size_t size = f->extent == BK_CHECKPOINT_SCALAR ? bk_checkpoint_type_size(f->type)
                                                        : sizeof(void *);
-        cover(covered, sizeof covered, f->offset, size, f->name);
+        if (f->catalog)
+            cover(covered_catalog, sizeof covered_catalog, f->offset, size, f->name);
+        else
+            cover(covered, sizeof covered, f->offset, size, f->name);
     }
+    expect_all_covered(covered_catalog, sizeof covered_catalog, "bk_catalog_state");
+    cover(covered, sizeof covered, offsetof(bk_checkpoint, catalog), sizeof(void *), "catalog");
     /* Framed outside the table: the counts that size the arrays, and the stats group. */
     cover(covered, sizeof covered, offsetof(bk_checkpoint, n_blocks), sizeof(size_t), "n_blocks");
     cover(covered, sizeof covered, offsetof(bk_checkpoint, n_state), sizeof(size_t), "n_state");
@@ -72,7 +78,7 @@ static void test_names_unique(void **state)
 {
     (void)state;
     static const char *const framed[] = {"n_blocks", "n_state", "rows", "transition_rows",
-                                         "last_transition_t", "sequence", "stats", "checksum",
+                                         "last_transition_t", "sequence", "stats", "checksum", "catalog",
                                          "units", "description"};
     for (size_t k = 0; k < bk_checkpoint_n_fields; ++k) {
         const char *name = bk_checkpoint_fields[k].name;
@@ -95,6 +101,7 @@ static void test_alloc_follows_table(void **state)
     for (size_t s = 0; s < sizeof sizes / sizeof sizes[0]; ++s) {
         bk_checkpoint cp;
         assert_int_equal(bk_checkpoint_alloc(&cp, sizes[s][0], sizes[s][1]), BK_OK);
+        assert_int_equal(bk_checkpoint_alloc_catalog(&cp), BK_OK);
         assert_int_equal(cp.n_blocks, sizes[s][0]);
         assert_int_equal(cp.n_state, sizes[s][1]);
         for (size_t k = 0; k < bk_checkpoint_n_fields; ++k) {
@@ -107,6 +114,7 @@ static void test_alloc_follows_table(void **state)
         }
         bk_checkpoint_free(&cp);
         assert_null(cp.x);
+        assert_null(cp.catalog);
         assert_int_equal(cp.n_blocks, 0);
     }
 }
@@ -184,6 +192,13 @@ static void fill(bk_checkpoint *cp)
     snprintf(cp->stats.method, sizeof cp->stats.method, "cvode_bdf");
 }
 
+/* A checkpoint of 5 blocks and 4 states with a catalog: every field present. */
+static void alloc_full(bk_checkpoint *cp)
+{
+    assert_int_equal(bk_checkpoint_alloc(cp, 5, 4), BK_OK);
+    assert_int_equal(bk_checkpoint_alloc_catalog(cp), BK_OK);
+}
+
 /* Perturb value i of field f by the smallest change its type allows. */
 static void nudge(const bk_checkpoint_field *f, bk_checkpoint *cp, size_t i)
 {
@@ -202,7 +217,7 @@ static void test_checksum_covers_every_value(void **state)
 {
     (void)state;
     bk_checkpoint cp;
-    assert_int_equal(bk_checkpoint_alloc(&cp, 5, 4), BK_OK);
+    alloc_full(&cp);
     fill(&cp);
     bk_checkpoint_record rec = {3, 1234, 56, 7.25};
     uint64_t base = bk_checkpoint_hash(&cp, &rec);
@@ -214,13 +229,13 @@ static void test_checksum_covers_every_value(void **state)
         if (bk_checkpoint_hash(&cp, &rec) == base)
             fail_msg("checkpoint field '%s' is not covered by the checksum", f->name);
         bk_checkpoint_free(&cp);
-        assert_int_equal(bk_checkpoint_alloc(&cp, 5, 4), BK_OK);
+        alloc_full(&cp);
         fill(&cp);
         assert_true(bk_checkpoint_hash(&cp, &rec) == base);
     }
     for (size_t k = 0; k < bk_run_stats_n_fields; ++k) {
         bk_checkpoint_free(&cp);
-        assert_int_equal(bk_checkpoint_alloc(&cp, 5, 4), BK_OK);
+        alloc_full(&cp);
         fill(&cp);
         char *member = (char *)&cp.stats + bk_run_stats_fields[k].offset;
         member[0] ^= 1;
@@ -228,7 +243,7 @@ static void test_checksum_covers_every_value(void **state)
             fail_msg("stat '%s' is not covered by the checksum", bk_run_stats_fields[k].name);
     }
     bk_checkpoint_free(&cp);
-    assert_int_equal(bk_checkpoint_alloc(&cp, 5, 4), BK_OK);
+    alloc_full(&cp);
     fill(&cp);
     cp.stats.method[0] = 'C';
     assert_true(bk_checkpoint_hash(&cp, &rec) != base);

@@ -481,8 +481,18 @@ static void test_commands(void **state)
     snprintf(cmd, sizeof cmd, "./bksim info %s/nothing.h5", tmpdir);
     assert_int_equal(run_command(cmd, NULL), 1);
 
-    /* stats: a run's output holds no catalog yet; a table of t_start and magnitude does. */
-    snprintf(cmd, sizeof cmd, "./bksim stats %s", out);
+    /* stats: a run's output holds its catalog (case A: one slip in 0.65 s); without one, a
+     * message names /events; a table of t_start and magnitude written elsewhere is read. */
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --json", out);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_non_null(strstr(text, "\"n_events\": 1,"));
+    free(text);
+    char bare[512];
+    snprintf(bare, sizeof bare, "%s/bare.h5", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --set run.t_end=0.65 --set output.events=false --quiet", path,
+             bare);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    snprintf(cmd, sizeof cmd, "./bksim stats %s", bare);
     assert_int_equal(run_command(cmd, &text), 1);
     assert_non_null(strstr(text, "/events"));
     free(text);

@@ -336,7 +336,7 @@ static velocity_log run_rice_ruina(double stiffness_factor)
              "[model]\nn_blocks = 1\n[block]\nmass = 1\ndriver_stiffness = %.17g\nv_init = %g\n[friction]\n"
              "law = dieterich_ruina_aging\na = %g\nb = %g\nDc = %g\nV0 = %g\nf0 = 0.6\ntheta_init = %.17g\n"
              "[driver]\nvelocity = %g\nstart_position = %.17g\n[solver]\nmethod = cvode_bdf\nrtol = 1e-9\n"
-             "[output]\ninterval = 0.01\n[run]\nt_end = %g\n",
+             "[output]\ninterval = 0.01\nevents = false\n[run]\nt_end = %g\n",
              stiffness_factor * k_c, V, a, b, Dc, V, 0.95 * Dc / V, V, 0.0, t_end);
     bk_config *c = NULL;
     bk_error err = {0};

@@ -9,6 +9,7 @@
 #include <hdf5.h>
 
 #include "bksim/bksim.h"
+#include "output/layout.h"
 #include "h5_raw.h"
 #include "output_fixture.h"
 #include "output_files.h"
@@ -102,6 +103,42 @@ static void test_verify_transitions(void **state)
     expect_damaged(f->path, "/transitions row 0 has a value that is not finite");
 }
 
+/* /events: read back whole, and each row checked (a catalog bksim writes is in time order,
+ * inside the chain, with t_end >= t_start and potency >= 0). */
+static void test_verify_events(void **state)
+{
+    output_fixture *f = *state;
+    bk_event ok[2] = {{.t_start = 0.01, .t_end = 0.02, .first_block = 1, .n_blocks = 2, .left = 0, .right = 1,
+                       .n_episodes = 2, .potency = 1e-4, .magnitude = -2.67, .max_slip_rate = 0.05,
+                       .stress_drop = 1.0, .complete = 1},
+                      {.t_start = 0.02, .t_end = 0.2, .first_block = 2, .n_blocks = 1, .left = 2, .right = 2,
+                       .n_episodes = 1, .potency = 0.0, .magnitude = -INFINITY, .complete = 0}};
+    write_small_with_events(f->path, NULL, 0, ok, 2);
+    bk_error err = {0};
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+    bk_event *back = NULL;
+    size_t n = 0;
+    assert_int_equal(bk_h5_read_events(f->path, &back, &n, &err), BK_OK);
+    assert_int_equal(n, 2);
+    assert_true(back[0].potency == 1e-4 && back[1].complete == 0 && back[1].magnitude == -INFINITY);
+    free(back);
+
+    bk_event swapped[2] = {ok[1], ok[0]};
+    write_small_with_events(f->path, NULL, 0, swapped, 2);
+    expect_damaged(f->path, "/events is not in time order at row 1");
+    bk_event reversed = ok[0];
+    reversed.t_end = 0.005;
+    write_small_with_events(f->path, NULL, 0, &reversed, 1);
+    expect_damaged(f->path, "/events row 0 has values no event has");
+    bk_event outside = ok[0];
+    outside.right = 3;
+    write_small_with_events(f->path, NULL, 0, &outside, 1);
+    expect_damaged(f->path, "/events row 0: first_block 1, left 0, right 3");
+    write_small_with_events(f->path, NULL, 0, ok, 2);
+    clobber_chunk(f->path, "events", 0, BK_EVENT_RECORD_BYTES);
+    expect_damaged(f->path, "/events rows 0..1 cannot be read");
+}
+
 /* Bytes damaged inside a chunk: the chunk's Fletcher32 checksum fails the read. */
 static void test_verify_flipped_chunk_bytes(void **state)
 {
@@ -144,6 +181,7 @@ int main(void)
         OUTPUT_TEST(test_verify_values),
         OUTPUT_TEST(test_verify_required_datasets),
         OUTPUT_TEST(test_verify_transitions),
+        OUTPUT_TEST(test_verify_events),
         OUTPUT_TEST(test_verify_flipped_chunk_bytes),
         OUTPUT_TEST(test_verify_file_without_dataset_record),
     };

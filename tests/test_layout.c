@@ -72,13 +72,16 @@ static void test_dataset_names(void **state)
 {
     (void)state;
     char names[BK_DATASET_LIST_LEN];
-    bk_output_dataset_names(BK_FIELD_ALL, 0, 1, names, sizeof names);
+    bk_output_dataset_names(BK_FIELD_ALL, 0, 1, 0, names, sizeof names);
     assert_string_equal(names, "time,driver,event,x,v,friction,cof,mode,energy_kinetic,"
                                "energy_elastic,work_driver,dissipation,transitions");
-    bk_output_dataset_names(BK_FIELD_ALL, 2, 0, names, sizeof names);
+    bk_output_dataset_names(BK_FIELD_ALL, 2, 0, 1, names, sizeof names);
     assert_string_equal(names, "time,driver,event,x,v,friction,cof,mode,energy_kinetic,"
-                               "energy_elastic,work_driver,dissipation,friction_state");
-    bk_output_dataset_names(BK_FIELD_V | BK_FIELD_STATE, 0, 0, names, sizeof names);
+                               "energy_elastic,work_driver,dissipation,friction_state,events");
+    bk_output_dataset_names(BK_FIELD_ALL, 0, 1, 1, names, sizeof names);
+    assert_string_equal(names, "time,driver,event,x,v,friction,cof,mode,energy_kinetic,"
+                               "energy_elastic,work_driver,dissipation,transitions,events");
+    bk_output_dataset_names(BK_FIELD_V | BK_FIELD_STATE, 0, 0, 0, names, sizeof names);
     assert_string_equal(names, "time,driver,event,v");
 }
 

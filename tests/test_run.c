@@ -384,7 +384,8 @@ static void test_per_block_laws(void **state)
         "[friction.1]\nlaw = rate_state\nmu_s = 0.6\nmu_d = 0.45\n"
         "[friction.2]\nlaw = carlson_langer\nF0 = 5.5\nsigma = 0.15\nalpha = 2\n"
         "[friction.3]\nlaw = dieterich_ruina_aging\na = 0.05\nb = 0.06\nDc = 1e-5\nV0 = 1e-3\nf0 = 0.45\n"
-        "[driver]\nvelocity = 1e-3\n[solver]\nmethod = cvode_bdf\nrtol = 1e-9\n[run]\nt_end = 2\n";
+        "[driver]\nvelocity = 1e-3\n[solver]\nmethod = cvode_bdf\nrtol = 1e-9\n[run]\nt_end = 2\n"
+        "[catalog]\nslip_rate_threshold = 1e-4\n";
     bk_config *c = NULL;
     bk_error err = {0};
     assert_int_equal(bk_config_load_string(text, "mixed.ini", NULL, 0, &c, &err), BK_OK);

@@ -12,6 +12,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "bksim/catalog.h"
 #include "bksim/run.h"
 
 /* Arrays have n_blocks entries (state: n_state).  Keep every member 8 bytes wide (or an
@@ -34,11 +35,14 @@ struct bk_checkpoint {
     double t_last_row;         /* s */
     long steps_since_row;
     bk_run_stats stats;        /* counters up to t */
+    bk_catalog_state *catalog; /* the event catalog builder; NULL when the run keeps none */
 };
 
 /* Allocate the arrays of a checkpoint for n blocks and s states (free with
  * bk_checkpoint_free); BK_ERR_NOMEM on failure (nothing left allocated). */
 int bk_checkpoint_alloc(bk_checkpoint *checkpoint, size_t n_blocks, size_t n_state);
+/* Add the catalog part (its arrays for n_blocks); BK_ERR_NOMEM on failure. */
+int bk_checkpoint_alloc_catalog(bk_checkpoint *checkpoint);
 void bk_checkpoint_free(bk_checkpoint *checkpoint);
 
 /* ---- the field-descriptor table ---- */
@@ -58,9 +62,10 @@ typedef enum bk_checkpoint_extent {
 
 typedef struct bk_checkpoint_field {
     const char *name; /* name in a checkpoint slot: a dataset for arrays, else an attribute */
+    int catalog;      /* a member of *catalog (bk_catalog_state), present only with one */
     bk_checkpoint_type type;
     bk_checkpoint_extent extent;
-    size_t offset;    /* offsetof(bk_checkpoint, member) */
+    size_t offset;    /* offsetof(bk_checkpoint or bk_catalog_state, member) */
 } bk_checkpoint_field;
 
 /* In the order written and hashed (part of the file format: files written by earlier
@@ -71,9 +76,12 @@ extern const bk_checkpoint_field bk_checkpoint_fields[];
 extern const size_t bk_checkpoint_n_fields;
 
 size_t bk_checkpoint_type_size(bk_checkpoint_type type);
-/* Values the field holds in this checkpoint: 1, n_blocks or n_state. */
+/* Whether this checkpoint has the field (a catalog field only with a catalog). */
+int bk_checkpoint_field_present(const bk_checkpoint_field *field, const bk_checkpoint *cp);
+/* Values the field holds in this checkpoint: 1, n_blocks or n_state (0 when absent). */
 size_t bk_checkpoint_field_count(const bk_checkpoint_field *field, const bk_checkpoint *cp);
-/* Where the values are: the array for array fields, the member itself for scalars. */
+/* Where the values are: the array for array fields, the member itself for scalars.  NULL when
+ * absent. */
 void *bk_checkpoint_field_data(const bk_checkpoint_field *field, bk_checkpoint *cp);
 const void *bk_checkpoint_field_cdata(const bk_checkpoint_field *field, const bk_checkpoint *cp);
 

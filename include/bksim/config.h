@@ -50,6 +50,8 @@ typedef struct bk_output_options {
     double interval;   /* s between samples; 0 = transition rows only; default t_end/1000 */
     unsigned fields;   /* BK_FIELD_* mask; default all */
     int transitions;   /* write /transitions; default 1 */
+    int events;        /* build the event catalog and write /events; default 1 (0 in a prescribed
+                          scene) */
     int event_rows;    /* add a row at every transition instant; default (auto): 1 for chains
                           of up to BK_EVENT_ROWS_AUTO_BLOCKS blocks, else 0 */
     double checkpoint_interval; /* s between checkpoints (restart points); 0 = none (default) */
@@ -67,11 +69,19 @@ typedef struct bk_prescribed {
     double *duration;         /* s per segment, > 0 */
 } bk_prescribed;
 
+/* The event catalog ([catalog]; bksim/catalog.h). */
+typedef struct bk_catalog_options {
+    double magnitude_offset;    /* added to (2/3) log10(potency / 1 m); default 0 */
+    double slip_rate_threshold; /* m/s: a block of a law without a stuck state slips (for the
+                                   catalog) while |v| exceeds it; NaN = none given */
+} bk_catalog_options;
+
 typedef struct bk_config {
     bk_model *model;          /* owned */
     bk_prescribed *prescribed; /* owned; NULL for the chain's dynamics */
     bk_solver_options solver;
     bk_output_options output;
+    bk_catalog_options catalog;
     double t_end;             /* s, > 0 */
     double wall_time_limit;   /* s of wall-clock time before the run stops with an error;
                                  0 = no limit (default) */

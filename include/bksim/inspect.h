@@ -40,5 +40,7 @@ int bk_h5_read_doubles(const char *path, const char *dataset, double **data, siz
 /* Read /transitions; *rows malloc'ed. */
 int bk_h5_read_transitions(const char *path, bk_transition **rows, size_t *count,
                            bk_error *err);
+/* Read /events (a catalog written by bksim: every bk_event field); *rows malloc'ed. */
+int bk_h5_read_events(const char *path, bk_event **rows, size_t *count, bk_error *err);
 
 #endif

@@ -8,7 +8,8 @@
  *   /x /v (T x N) m, m/s, /friction (T x N) N, /cof (T x N) 1, /mode (T x N) int8,
  *   /energy_kinetic /energy_elastic /work_driver /dissipation (T) J,
  *   /friction_state (T x S) per law,
- *   /transitions compound {t, block, from, to, x, v, force}.
+ *   /transitions compound {t, block, from, to, x, v, force},
+ *   /events compound, one row per slip event (bksim/catalog.h; [output] events).
  * Every chunked dataset carries Fletcher32 checksums, so damaged chunk bytes fail the read.
  * Root attributes: config (full text), config_file and overrides (what a restart reloads),
  * config_name, version, n_blocks, complete (0 until the run finished), t_end, t_reached, and

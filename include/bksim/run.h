@@ -43,6 +43,8 @@ typedef struct bk_transition {
 
 /* A checkpoint (bksim/checkpoint.h): the state a run continues from. */
 typedef struct bk_checkpoint bk_checkpoint;
+/* An event of the catalog (bksim/catalog.h). */
+typedef struct bk_event bk_event;
 
 typedef struct bk_sink {
     void *self;
@@ -51,6 +53,8 @@ typedef struct bk_sink {
     /* At every [output] checkpoint_interval; may be NULL.  The arrays are valid only during
      * the call. */
     int (*checkpoint)(void *self, const bk_checkpoint *checkpoint, bk_error *err);
+    /* Each event of the catalog as it completes ([output] events); may be NULL. */
+    int (*event)(void *self, const bk_event *event, bk_error *err);
 } bk_sink;
 
 typedef struct bk_run_stats {

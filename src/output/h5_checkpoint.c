@@ -170,7 +170,11 @@ int bk_h5_sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
     if (group < 0)
         ok = -1;
     for (size_t k = 0; ok >= 0 && k < bk_checkpoint_n_fields; ++k)
-        ok = put_field(group, &bk_checkpoint_fields[k], cp);
+        if (bk_checkpoint_field_present(&bk_checkpoint_fields[k], cp))
+            ok = put_field(group, &bk_checkpoint_fields[k], cp);
+    /* Whether the slot holds a catalog: read before its fields, as the counts are. */
+    if (ok >= 0)
+        ok = bk_h5_write_long_attr(group, "catalog", cp->catalog != NULL);
     if (ok >= 0)
         ok = bk_h5_write_long_attr(group, "n_blocks", (long long)cp->n_blocks);
     if (ok >= 0)
@@ -293,6 +297,17 @@ static int slot_matches_data(hid_t file, const bk_checkpoint *cp, const bk_check
         rc = -1;
     }
     bk_h5_close_id(time);
+    if (rc == 0 && cp->catalog && cp->catalog->events > 0) {
+        hid_t events = H5Lexists(file, "events", H5P_DEFAULT) > 0 ? H5Dopen2(file, "events", H5P_DEFAULT)
+                                                                : H5I_INVALID_HID;
+        long long count = events < 0 ? -1 : leading_dim(events);
+        bk_h5_close_id(events);
+        if (count < cp->catalog->events) {
+            snprintf(why, why_len, "records %ld events, /events has %lld", cp->catalog->events,
+                     count < 0 ? 0 : count);
+            rc = -1;
+        }
+    }
     if (rc < 0 || rec->transition_rows == 0)
         return rc;
     hid_t table = H5Lexists(file, "transitions", H5P_DEFAULT) > 0
@@ -351,9 +366,20 @@ static int read_slot(hid_t file, hid_t top, const char *name, size_t n_blocks,
         snprintf(why, why_len, "out of memory");
         return BK_ERR_NOMEM;
     }
-    herr_t ok = 0;
+    /* Slots written before catalogs have no "catalog" attribute, and none. */
+    long long has_catalog = 0;
+    if (H5Aexists(group, "catalog") > 0 &&
+        bk_h5_read_numeric_attr(group, "catalog", H5T_NATIVE_LLONG, &has_catalog) < 0)
+        has_catalog = -1;
+    if (has_catalog == 1 && bk_checkpoint_alloc_catalog(cp) != BK_OK) {
+        CLOSE_IDS(0, group);
+        snprintf(why, why_len, "out of memory");
+        return BK_ERR_NOMEM;
+    }
+    herr_t ok = has_catalog == 0 || has_catalog == 1 ? 0 : -1;
     for (size_t k = 0; ok >= 0 && k < bk_checkpoint_n_fields; ++k)
-        ok = get_field(group, &bk_checkpoint_fields[k], cp);
+        if (bk_checkpoint_field_present(&bk_checkpoint_fields[k], cp))
+            ok = get_field(group, &bk_checkpoint_fields[k], cp);
     uint64_t stored = 0;
     if (ok >= 0)
         ok = bk_h5_read_numeric_attr(group, "rows", H5T_NATIVE_LLONG, &rec->rows);
@@ -569,6 +595,20 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
                 truncate_rows(w->trans_dset, (hsize_t)rec->transition_rows, w->trans_mem,
                               sizeof(bk_transition)) < 0)
                 rc = H5_FAIL(err, "%s: cannot reopen /transitions at the checkpoint", w->part);
+        }
+        /* /events goes with a checkpoint that carries the catalog: both, or neither. */
+        int has_events = rc == BK_OK ? H5Lexists(w->file, "events", H5P_DEFAULT) > 0 : 0;
+        if (rc == BK_OK && has_events != (cp->catalog != NULL))
+            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: %s", w->part,
+                         has_events ? "/events exists but the checkpoint holds no catalog"
+                                    : "the checkpoint holds a catalog but there is no /events");
+        if (rc == BK_OK && has_events) {
+            int buffered = bk_h5_writer_event_buffer(w);
+            w->ev_dset = H5Dopen2(w->file, "events", H5P_DEFAULT);
+            if (buffered < 0 || w->ev_dset < 0 ||
+                truncate_rows(w->ev_dset, (hsize_t)cp->catalog->events, w->ev_mem, sizeof(bk_event)) < 0)
+                rc = H5_FAIL(err, "%s: cannot reopen /events at the checkpoint", w->part);
+            w->ev_written = (hsize_t)cp->catalog->events;
         }
         w->rows_written = rows;
         w->trans_written = (hsize_t)rec->transition_rows;

@@ -29,6 +29,7 @@
  * Appends of fewer rows go through the per-dataset chunk cache (1 MiB by default). */
 #define SERIES_1D_CHUNK 4096u
 #define TRANSITION_BUFFER 512u
+#define EVENT_BUFFER 256u
 /* Doubles held in memory per block of rows while exporting or checking. */
 #define EXPORT_BUDGET (1u << 20)
 
@@ -59,6 +60,11 @@ struct bk_h5_writer {
     size_t trans_buffered;
     hsize_t trans_written;
     double trans_last_t; /* t of the last transition on disk */
+    hid_t ev_dset;       /* /events, H5I_INVALID_HID when the run keeps no catalog */
+    hid_t ev_mem;
+    bk_event *ev_buf;
+    size_t ev_buffered;
+    hsize_t ev_written;
     long long cp_sequence; /* of the last checkpoint written (0: none) */
     int cp_slot;         /* slot of /checkpoint the next checkpoint goes to */
     int failed;          /* a write failed: rows on disk may be ragged, accept no more */
@@ -74,6 +80,8 @@ void bk_h5_writer_size(bk_h5_writer *w, const bk_model *model);
 int bk_h5_writer_series(bk_h5_writer *w, int i, const bk_model *model);
 /* The transition buffer and its memory type; -1 on failure. */
 int bk_h5_writer_transition_buffer(bk_h5_writer *w);
+/* The event buffer and its memory type; -1 on failure. */
+int bk_h5_writer_event_buffer(bk_h5_writer *w);
 /* Close every id the writer holds; -1 if any close failed. */
 herr_t bk_h5_writer_close(bk_h5_writer *w);
 void bk_h5_writer_free(bk_h5_writer *w);
@@ -130,6 +138,8 @@ hid_t bk_h5_kind_file_type(bk_series_kind kind);
 hid_t bk_h5_kind_mem_type(bk_series_kind kind);
 /* The transition record in memory (bk_transition) or on disk (packed little-endian). */
 hid_t bk_h5_transition_type(int on_disk);
+/* The event record in memory (bk_event) or on disk (packed little-endian). */
+hid_t bk_h5_event_type(int on_disk);
 
 /* ------------------------------------------------------------------- readers --- */
 

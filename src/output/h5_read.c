@@ -373,3 +373,39 @@ int bk_h5_load_stored_config(hid_t file, const char *path, bk_config **config, b
     free(overrides);
     return rc;
 }
+
+int bk_h5_read_events(const char *path, bk_event **rows, size_t *count, bk_error *err)
+{
+    if (!rows || !count)
+        return BK_FAIL(err, BK_ERR_INVALID, "bk_h5_read_events: missing argument");
+    *rows = NULL;
+    *count = 0;
+    hid_t file;
+    int rc = bk_h5_open_input(path, &file, err);
+    if (rc != BK_OK)
+        return rc;
+    hid_t dset = H5Lexists(file, "events", H5P_DEFAULT) > 0 ? H5Dopen2(file, "events", H5P_DEFAULT)
+                                                            : H5I_INVALID_HID;
+    hid_t mem = dset < 0 ? H5I_INVALID_HID : bk_h5_event_type(0);
+    hid_t space = dset < 0 ? H5I_INVALID_HID : H5Dget_space(dset);
+    hssize_t n = space < 0 ? -1 : H5Sget_simple_extent_npoints(space);
+    if (dset < 0 || mem < 0 || n < 0) {
+        rc = dset < 0 ? BK_FAIL(err, BK_ERR_INVALID, "%s: no /events table", path)
+                      : H5_FAIL(err, "%s: cannot read /events", path);
+    } else {
+        bk_event *values = (size_t)n > SIZE_MAX / sizeof *values ? NULL
+                                                                  : calloc(n ? (size_t)n : 1, sizeof *values);
+        if (!values)
+            rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory reading /events", path);
+        else if (n > 0 && H5Dread(dset, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, values) < 0)
+            rc = H5_FAIL(err, "%s: cannot read /events (a table of bksim's event fields)", path);
+        if (rc == BK_OK) {
+            *rows = values;
+            *count = (size_t)n;
+        } else {
+            free(values);
+        }
+    }
+    CLOSE_IDS(rc, space, mem, dset, file);
+    return rc;
+}

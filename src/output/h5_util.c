@@ -345,3 +345,39 @@ hid_t bk_h5_transition_type(int on_disk)
     }
     return type;
 }
+
+/* The event record in memory (bk_event) and on disk (packed little-endian). */
+hid_t bk_h5_event_type(int on_disk)
+{
+    static const struct {
+        const char *name;
+        size_t offset, disk_offset;
+        int kind; /* 0: double, 1: int32, 2: int8 */
+    } fields[] = {
+        {"t_start", offsetof(bk_event, t_start), 0, 0},
+        {"t_end", offsetof(bk_event, t_end), 8, 0},
+        {"first_block", offsetof(bk_event, first_block), 16, 1},
+        {"n_blocks", offsetof(bk_event, n_blocks), 20, 1},
+        {"left", offsetof(bk_event, left), 24, 1},
+        {"right", offsetof(bk_event, right), 28, 1},
+        {"n_episodes", offsetof(bk_event, n_episodes), 32, 1},
+        {"potency", offsetof(bk_event, potency), 36, 0},
+        {"magnitude", offsetof(bk_event, magnitude), 44, 0},
+        {"max_slip_rate", offsetof(bk_event, max_slip_rate), 52, 0},
+        {"stress_drop", offsetof(bk_event, stress_drop), 60, 0},
+        {"complete", offsetof(bk_event, complete), 68, 2},
+    };
+    hid_t type = H5Tcreate(H5T_COMPOUND, on_disk ? BK_EVENT_RECORD_BYTES : sizeof(bk_event));
+    herr_t rc = type < 0 ? -1 : 0;
+    for (size_t k = 0; rc >= 0 && k < sizeof fields / sizeof fields[0]; ++k) {
+        hid_t member = fields[k].kind == 0 ? (on_disk ? H5T_IEEE_F64LE : H5T_NATIVE_DOUBLE)
+                       : fields[k].kind == 1 ? (on_disk ? H5T_STD_I32LE : H5T_NATIVE_INT32)
+                                             : (on_disk ? H5T_STD_I8LE : H5T_NATIVE_INT8);
+        rc = H5Tinsert(type, fields[k].name, on_disk ? fields[k].disk_offset : fields[k].offset, member);
+    }
+    if (rc < 0) {
+        CLOSE_IDS(-1, type);
+        return H5I_INVALID_HID;
+    }
+    return type;
+}

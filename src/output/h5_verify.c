@@ -165,6 +165,62 @@ static int scan_transitions(hid_t file, const verify_ctx *v, bk_error *err)
     return rc;
 }
 
+/* One /events row as a catalog bksim wrote holds it. */
+static int check_event(const verify_ctx *v, const bk_event *e, unsigned long long row, double *prev,
+                       bk_error *err)
+{
+    const char *path = v->path;
+    long long n = v->n_blocks;
+    int blocks_ok = e->first_block >= 0 && e->first_block < n && e->left >= 0 && e->left < n &&
+                    e->right >= 0 && e->right < n && e->n_blocks >= 1 && e->n_blocks <= n &&
+                    e->n_episodes >= e->n_blocks;
+    if (!isfinite(e->t_start) || !isfinite(e->t_end) || !(e->t_end >= e->t_start) || !(e->potency >= 0.0) ||
+        isnan(e->magnitude) || !isfinite(e->stress_drop) || !(e->max_slip_rate >= 0.0))
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /events row %llu has values no event has "
+                       "(t_start %g, t_end %g, potency %g, magnitude %g, max_slip_rate %g, stress_drop %g)",
+                       path, row, e->t_start, e->t_end, e->potency, e->magnitude, e->max_slip_rate,
+                       e->stress_drop);
+    if (!blocks_ok || (e->complete != 0 && e->complete != 1))
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /events row %llu: first_block %d, left %d, "
+                       "right %d, n_blocks %d, n_episodes %d, complete %d (blocks 0..%lld)", path, row,
+                       (int)e->first_block, (int)e->left, (int)e->right, (int)e->n_blocks,
+                       (int)e->n_episodes, (int)e->complete, n - 1);
+    if (e->t_start < *prev)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /events is not in time order at row %llu "
+                       "(t_start = %.17g s after an event that ended at %.17g s)", path, row, e->t_start, *prev);
+    *prev = e->t_end;
+    return BK_OK;
+}
+
+/* Every /events row read (the chunk checksums) and checked, a buffer at a time. */
+static int scan_events(hid_t file, const verify_ctx *v, bk_error *err)
+{
+    hid_t dset = H5Dopen2(file, "events", H5P_DEFAULT);
+    hid_t mem = dset < 0 ? H5I_INVALID_HID : bk_h5_event_type(0);
+    hid_t space = dset < 0 ? H5I_INVALID_HID : H5Dget_space(dset);
+    hssize_t n = space < 0 ? -1 : H5Sget_simple_extent_npoints(space);
+    bk_event *buf = malloc(EVENT_BUFFER * sizeof *buf);
+    int rc = BK_OK;
+    if (!buf)
+        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", v->path);
+    else if (mem < 0 || n < 0)
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /events cannot be read", v->path);
+    double prev = -INFINITY;
+    for (hsize_t start = 0; rc == BK_OK && start < (hsize_t)n; start += EVENT_BUFFER) {
+        hsize_t count = (hsize_t)n - start < EVENT_BUFFER ? (hsize_t)n - start : EVENT_BUFFER;
+        if (bk_h5_read_block(dset, 1, start, count, 0, 1, mem, buf) < 0) {
+            rc = H5_DAMAGED(err, "%s: damaged: /events rows %llu..%llu cannot be read", v->path,
+                            (unsigned long long)start, (unsigned long long)(start + count - 1));
+            break;
+        }
+        for (hsize_t k = 0; rc == BK_OK && k < count; ++k)
+            rc = check_event(v, &buf[k], (unsigned long long)(start + k), &prev, err);
+    }
+    free(buf);
+    CLOSE_IDS(rc == BK_OK ? 0 : -1, space, mem, dset);
+    return rc;
+}
+
 /* The datasets a file must hold: those its writer recorded, or for a file written before
  * that record, those its stored config selects (time, driver, event if it does not load).
  * Malloc'ed, comma-separated; NULL when out of memory. */
@@ -178,7 +234,7 @@ static char *expected_datasets(hid_t file)
     char list[BK_DATASET_LIST_LEN] = "time,driver,event";
     if (bk_h5_load_stored_config(file, "", &config, &ignored) == BK_OK)
         bk_output_dataset_names(config->output.fields, config->model->n_friction_state,
-                     config->output.transitions, list, sizeof list);
+                     config->output.transitions, config->output.events, list, sizeof list);
     bk_config_free(config);
     return strdup(list);
 }
@@ -245,6 +301,8 @@ int bk_h5_verify_open(hid_t file, const char *path, bk_error *err)
     bk_h5_name_list_free(&list);
     if (rc == BK_OK && H5Lexists(file, "transitions", H5P_DEFAULT) > 0)
         rc = scan_transitions(file, &v, err);
+    if (rc == BK_OK && H5Lexists(file, "events", H5P_DEFAULT) > 0)
+        rc = scan_events(file, &v, err);
     if (rc == BK_OK && H5Lexists(file, "checkpoint", H5P_DEFAULT) > 0) {
         bk_h5_slot slot;
         bk_error why = {0};

@@ -116,7 +116,8 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
         stored = bk_h5_write_string_attr(w->file, "overrides", overrides);
     free(overrides);
     char names[BK_DATASET_LIST_LEN];
-    bk_output_dataset_names(fields, n_state, config->output.transitions, names, sizeof names);
+    bk_output_dataset_names(fields, n_state, config->output.transitions, config->output.events, names,
+                            sizeof names);
     if (stored >= 0)
         stored = bk_h5_write_string_attr(w->file, "datasets", names);
     if (stored < 0)
@@ -157,6 +158,19 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
         if (bk_h5_describe(w->trans_dset, BK_TRANSITIONS_UNITS, BK_TRANSITIONS_DESCRIPTION) < 0)
             return H5_FAIL(err, "%s: cannot write attributes of /transitions", w->part);
     }
+    if (config->output.events) {
+        if (bk_h5_writer_event_buffer(w) < 0)
+            return w->ev_buf ? H5_FAIL(err, "%s: cannot create dataset /events", w->part)
+                             : BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for the event buffer", w->part);
+        hid_t disk = bk_h5_event_type(1);
+        if (disk >= 0)
+            w->ev_dset = create_extendable(w->file, "events", disk, 1, 1, EVENT_BUFFER);
+        CLOSE_IDS(w->ev_dset, disk);
+        if (w->ev_dset < 0)
+            return H5_FAIL(err, "%s: cannot create dataset /events", w->part);
+        if (bk_h5_describe(w->ev_dset, BK_EVENTS_UNITS, BK_EVENTS_DESCRIPTION) < 0)
+            return H5_FAIL(err, "%s: cannot write attributes of /events", w->part);
+    }
     /* The variable-length strings above go to disk now, once: nothing rewrites them later
      * (see bk_h5_write_fixed_string_attr). */
     if (H5Fflush(w->file, H5F_SCOPE_LOCAL) < 0)
@@ -185,7 +199,12 @@ herr_t bk_h5_writer_close(bk_h5_writer *w)
         rc = -1;
     if (w->trans_mem >= 0 && H5Tclose(w->trans_mem) < 0)
         rc = -1;
+    if (w->ev_dset >= 0 && H5Dclose(w->ev_dset) < 0)
+        rc = -1;
+    if (w->ev_mem >= 0 && H5Tclose(w->ev_mem) < 0)
+        rc = -1;
     w->trans_dset = w->trans_mem = w->file = H5I_INVALID_HID;
+    w->ev_dset = w->ev_mem = H5I_INVALID_HID;
     return rc;
 }
 
@@ -194,6 +213,7 @@ void bk_h5_writer_free(bk_h5_writer *w)
     for (int i = 0; i < BK_N_SERIES; ++i)
         free(w->s[i].buf);
     free(w->trans_buf);
+    free(w->ev_buf);
     free(w->path);
     free(w->part);
     free(w);
@@ -206,6 +226,7 @@ int bk_h5_writer_new(bk_h5_writer **out, const char *path, bk_error *err)
     if (!w)
         return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
     w->file = w->trans_dset = w->trans_mem = H5I_INVALID_HID;
+    w->ev_dset = w->ev_mem = H5I_INVALID_HID;
     for (int i = 0; i < BK_N_SERIES; ++i)
         w->s[i].dset = H5I_INVALID_HID;
     w->path = strdup(path);
@@ -243,6 +264,13 @@ int bk_h5_writer_transition_buffer(bk_h5_writer *w)
     w->trans_buf = malloc(TRANSITION_BUFFER * sizeof *w->trans_buf);
     w->trans_mem = w->trans_buf ? bk_h5_transition_type(0) : H5I_INVALID_HID;
     return w->trans_buf && w->trans_mem >= 0 ? 0 : -1;
+}
+
+int bk_h5_writer_event_buffer(bk_h5_writer *w)
+{
+    w->ev_buf = malloc(EVENT_BUFFER * sizeof *w->ev_buf);
+    w->ev_mem = w->ev_buf ? bk_h5_event_type(0) : H5I_INVALID_HID;
+    return w->ev_buf && w->ev_mem >= 0 ? 0 : -1;
 }
 
 int bk_h5_writer_open(bk_h5_writer **out, const bk_config *config, const char *path,
@@ -321,7 +349,21 @@ static int flush_transitions(bk_h5_writer *w, bk_error *err)
     return BK_OK;
 }
 
-/* Write buffered rows and transitions, then flush HDF5's metadata so that a run killed
+static int flush_events(bk_h5_writer *w, bk_error *err)
+{
+    if (w->ev_buffered == 0)
+        return BK_OK;
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    if (append(w->ev_dset, 1, w->ev_written, (hsize_t)w->ev_buffered, 1, w->ev_mem, w->ev_buf) < 0) {
+        w->failed = 1;
+        return H5_FAIL(err, "%s: cannot append to /events", w->part);
+    }
+    w->ev_written += w->ev_buffered;
+    w->ev_buffered = 0;
+    return BK_OK;
+}
+
+/* Write buffered rows, transitions and events, then flush HDF5's metadata so that a run killed
  * later still leaves a readable .part holding everything up to here. */
 int bk_h5_writer_flush(bk_h5_writer *w, bk_error *err)
 {
@@ -342,6 +384,8 @@ int bk_h5_writer_flush(bk_h5_writer *w, bk_error *err)
         w->t_written = w->t_buffered;
     }
     int rc = flush_transitions(w, err);
+    if (rc == BK_OK)
+        rc = flush_events(w, err);
     if (rc != BK_OK)
         return rc;
     if (bk_h5_write_double_attr(w->file, "t_reached", w->t_written) < 0 ||
@@ -412,9 +456,20 @@ static int sink_transition(void *self, const bk_transition *transition, bk_error
     return w->trans_buffered == TRANSITION_BUFFER ? flush_transitions(w, err) : BK_OK;
 }
 
+static int sink_event(void *self, const bk_event *event, bk_error *err)
+{
+    bk_h5_writer *w = self;
+    if (w->failed)
+        return BK_FAIL(err, BK_ERR_HDF5, "%s: an earlier write failed; no more events accepted", w->part);
+    if (w->ev_dset < 0)
+        return BK_OK;
+    w->ev_buf[w->ev_buffered++] = *event;
+    return w->ev_buffered == EVENT_BUFFER ? flush_events(w, err) : BK_OK;
+}
+
 bk_sink bk_h5_writer_sink(bk_h5_writer *writer)
 {
-    bk_sink sink = {writer, sink_sample, sink_transition, bk_h5_sink_checkpoint};
+    bk_sink sink = {writer, sink_sample, sink_transition, bk_h5_sink_checkpoint, sink_event};
     return sink;
 }
 

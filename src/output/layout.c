@@ -79,8 +79,8 @@ double bk_output_row_bytes(unsigned fields, size_t n_blocks, size_t n_state)
     return bytes;
 }
 
-void bk_output_dataset_names(unsigned fields, size_t n_state, int transitions, char *buf,
-                             size_t len)
+void bk_output_dataset_names(unsigned fields, size_t n_state, int transitions, int events,
+                             char *buf, size_t len)
 {
     size_t used = 0;
     buf[0] = '\0';
@@ -90,6 +90,11 @@ void bk_output_dataset_names(unsigned fields, size_t n_state, int transitions, c
             if (n > 0 && (size_t)n < len - used)
                 used += (size_t)n;
         }
-    if (transitions)
-        snprintf(buf + used, len - used, "%stransitions", used ? "," : "");
+    if (transitions) {
+        int n = snprintf(buf + used, len - used, "%stransitions", used ? "," : "");
+        if (n > 0 && (size_t)n < len - used)
+            used += (size_t)n;
+    }
+    if (events)
+        snprintf(buf + used, len - used, "%sevents", used ? "," : "");
 }

@@ -42,6 +42,21 @@ extern const char *const bk_output_field_names[];
     "mode transitions: time, block (0-based), from/to mode (stick 0, slip+ 1, slip- -1), " \
     "position, velocity after the transition, applied spring force"
 
+/* Bytes of one /events record on disk (packed: t_start, t_end, first_block, n_blocks, left,
+ * right, n_episodes, potency, magnitude, max_slip_rate, stress_drop, complete). */
+#define BK_EVENT_RECORD_BYTES 69
+
+#define BK_EVENTS_UNITS                                                                      \
+    "t_start: s, t_end: s, first_block: 1, n_blocks: 1, left: 1, right: 1, n_episodes: 1, " \
+    "potency: m, magnitude: 1, max_slip_rate: m/s, stress_drop: N, complete: 1"
+#define BK_EVENTS_DESCRIPTION                                                                     \
+    "slip events: maximal intervals during which some block slips (ruptures that overlap in "  \
+    "time are one event). first_block: the first to slip; left..right: the extent (on a ring "  \
+    "the shorter arc covering the blocks, left > right when it wraps past block 0); potency: "  \
+    "sum of the slip of every episode; magnitude: (2/3) log10(potency / 1 m) + "              \
+    "magnitude_offset; stress_drop: mean drop of the applied force over the blocks; "          \
+    "complete: 0 for an event still running at the end of the run"
+
 /* Whether a run with these output fields and friction states writes this series: the one
  * rule behind the layout, the list of datasets a reader must find and the size estimate. */
 int bk_series_selected(const bk_series_def *def, unsigned fields, size_t n_state);
@@ -58,7 +73,7 @@ double bk_output_row_bytes(unsigned fields, size_t n_blocks, size_t n_state);
 /* The datasets a run of this layout writes, comma-separated (recorded in the root attribute
  * "datasets" so that a check needs no config to know what must be there). */
 #define BK_DATASET_LIST_LEN 256
-void bk_output_dataset_names(unsigned fields, size_t n_state, int transitions, char *buf,
-                             size_t len);
+void bk_output_dataset_names(unsigned fields, size_t n_state, int transitions, int events,
+                             char *buf, size_t len);
 
 #endif

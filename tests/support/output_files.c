@@ -186,8 +186,15 @@ void write_small(const char *path, int with_state)
 /* write_small with these transitions instead of the usual five. */
 void write_small_with(const char *path, const bk_transition *transitions, size_t n)
 {
+    write_small_with_events(path, transitions, n, NULL, 0);
+}
+
+void write_small_with_events(const char *path, const bk_transition *transitions, size_t n,
+                             const bk_event *events, size_t n_events)
+{
     bk_config *c = synthetic_config(3, BK_FIELD_ALL, 1, 0);
     c->t_end = 0.2;
+    c->output.events = events != NULL;
     bk_h5_writer *w;
     bk_error err;
     assert_int_equal(bk_h5_writer_open(&w, c, path, &err), BK_OK);
@@ -201,6 +208,8 @@ void write_small_with(const char *path, const bk_transition *transitions, size_t
     }
     for (size_t k = 0; k < n; ++k)
         assert_int_equal(sink.transition(sink.self, &transitions[k], &err), BK_OK);
+    for (size_t k = 0; k < n_events; ++k)
+        assert_int_equal(sink.event(sink.self, &events[k], &err), BK_OK);
     bk_run_stats stats = example_stats();
     assert_int_equal(bk_h5_writer_finish(w, &stats, &err), BK_OK);
     bk_config_free(c);

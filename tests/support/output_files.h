@@ -37,6 +37,9 @@ void write_file(const char *path, const bk_config *c, size_t rows, size_t count)
 void write_small(const char *path, int with_state);
 /* write_small with these transitions instead of the usual five. */
 void write_small_with(const char *path, const bk_transition *transitions, size_t n);
+/* The same with /events holding these events (none written when events is NULL). */
+void write_small_with_events(const char *path, const bk_transition *transitions, size_t n,
+                             const bk_event *events, size_t n_events);
 
 /* Series `name` of path holds rows x cols values of series `which` (-1: row_time). */
 void check_series(const char *path, const char *name, size_t rows, size_t cols, int which);

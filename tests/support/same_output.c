@@ -41,4 +41,27 @@ void assert_same_output(const char *a, const char *b)
     }
     free(ta);
     free(tb);
+    bk_event *ea = NULL, *eb = NULL;
+    size_t ma = 0, mb = 0;
+    int events_a = bk_h5_read_events(a, &ea, &ma, &err) == BK_OK;
+    int events_b = bk_h5_read_events(b, &eb, &mb, &err) == BK_OK;
+    assert_int_equal(events_a, events_b);
+    assert_int_equal(ma, mb);
+    for (size_t k = 0; k < ma; ++k)
+        assert_same_event(&ea[k], &eb[k]);
+    free(ea);
+    free(eb);
+}
+
+void assert_same_event(const bk_event *a, const bk_event *b)
+{
+    const double fa[] = {a->t_start, a->t_end, a->potency, a->magnitude, a->max_slip_rate, a->stress_drop};
+    const double fb[] = {b->t_start, b->t_end, b->potency, b->magnitude, b->max_slip_rate, b->stress_drop};
+    assert_memory_equal(fa, fb, sizeof fa);
+    assert_int_equal(a->first_block, b->first_block);
+    assert_int_equal(a->n_blocks, b->n_blocks);
+    assert_int_equal(a->left, b->left);
+    assert_int_equal(a->right, b->right);
+    assert_int_equal(a->n_episodes, b->n_episodes);
+    assert_int_equal(a->complete, b->complete);
 }

@@ -1,0 +1,295 @@
+/* The event catalog during a run: the builder (bksim/catalog.h) fed with every transition as
+ * it happens, completed events handed to the sink, the largest slip rate of each event, and
+ * for laws without a stuck state the threshold crossings that stand in for transitions.
+ *
+ * The largest slip rate.  Between restarts a block's speed |v| is smooth, so its maxima are
+ * at step ends or where d|v|/dt falls through zero inside a step.  Each step end is looked at
+ * (O(slipping blocks)); a maximum inside a step is first estimated by the cubic Hermite
+ * interpolant of |v| and d|v|/dt at the step's two ends, and only the step's largest estimate,
+ * and only if it could raise the event's maximum, is located on the back-end's own dense
+ * output (Brent).  So a chain's synchronous maxima cost one location per step, not one per
+ * block, and the value is the interpolant's: exact for the exact stepper, within the
+ * tolerances otherwise. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "output/layout.h"
+#include "run_impl.h"
+
+static double applied_force(const void *user, size_t i)
+{
+    const run_ctx *ctx = user;
+    double driver_pos = bk_driver_position(&ctx->model->driver, ctx->t_catalog);
+    return bk_scene_applied_force(&ctx->scene, i, driver_pos);
+}
+
+/* For the builder: stuck or slipping, and for a law without a stuck state below or above the
+ * threshold. */
+static int8_t catalog_mode(const run_ctx *ctx, size_t i)
+{
+    const bk_scene *scene = &ctx->scene;
+    if (scene->can_stick[i])
+        return scene->mode[i];
+    return scene->above[i] ? (int8_t)BK_MODE_SLIP_POS : (int8_t)BK_MODE_STICK;
+}
+
+int bk_run_catalog_init(run_ctx *ctx, const bk_checkpoint *from)
+{
+    const bk_config *config = ctx->config;
+    if (!config->output.events || (from && !from->catalog))
+        return BK_OK; /* a checkpoint from before catalogs: the resumed run writes none */
+    bk_scene *scene = &ctx->scene;
+    size_t n = scene->n;
+    ctx->catalog = bk_catalog_create(n, ctx->model->boundary == BK_BOUNDARY_PERIODIC,
+                                     config->catalog.magnitude_offset);
+    ctx->rate_v = malloc(n * sizeof *ctx->rate_v);
+    ctx->rate_a = malloc(n * sizeof *ctx->rate_a);
+    ctx->catalog_modes = malloc(n * sizeof *ctx->catalog_modes);
+    int creeping = 0;
+    for (size_t i = 0; i < n; ++i)
+        creeping |= !scene->can_stick[i];
+    if (creeping) {
+        scene->slip_threshold = config->catalog.slip_rate_threshold;
+        scene->above = calloc(n, sizeof *scene->above);
+    }
+    if (!ctx->catalog || !ctx->rate_v || !ctx->rate_a || !ctx->catalog_modes || (creeping && !scene->above))
+        return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the event catalog of %zu blocks", n);
+    if (ctx->checkpoint_interval > 0.0) {
+        bk_catalog_state *s = &ctx->catalog_state;
+        s->x_onset = malloc(n * sizeof *s->x_onset);
+        s->first_force = malloc(n * sizeof *s->first_force);
+        s->last_force = malloc(n * sizeof *s->last_force);
+        s->involved = malloc(n * sizeof *s->involved);
+        s->slipping = malloc(n * sizeof *s->slipping);
+        if (!s->x_onset || !s->first_force || !s->last_force || !s->involved || !s->slipping)
+            return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the event catalog of %zu blocks", n);
+    }
+    if (from) {
+        if (bk_catalog_restore(ctx->catalog, from->catalog) != BK_OK)
+            return BK_FAIL(ctx->err, BK_ERR_INVALID,
+                           "the checkpoint's event catalog does not hold together (a slipping block "
+                           "outside the open event, or an open event without blocks)");
+        ctx->events = from->catalog->events;
+        for (size_t i = 0; i < n && scene->above; ++i)
+            scene->above[i] = !scene->can_stick[i] && from->catalog->slipping[i];
+        return BK_OK;
+    }
+    /* Blocks that move at t = 0 slip from the start; resting ones start slipping through
+     * transitions at t = 0, which the builder then sees. */
+    for (size_t i = 0; i < n; ++i) {
+        if (scene->above)
+            scene->above[i] = !scene->can_stick[i] && fabs(scene->v[i]) > scene->slip_threshold;
+        ctx->catalog_modes[i] = scene->can_stick[i] ? (scene->v[i] > 0.0   ? (int8_t)BK_MODE_SLIP_POS
+                                                       : scene->v[i] < 0.0 ? (int8_t)BK_MODE_SLIP_NEG
+                                                                           : (int8_t)BK_MODE_STICK)
+                                                    : catalog_mode(ctx, i);
+    }
+    ctx->t_catalog = 0.0;
+    if (bk_catalog_begin(ctx->catalog, 0.0, ctx->catalog_modes, scene->x, scene->v, applied_force, ctx) != BK_OK)
+        return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the event catalog");
+    return BK_OK;
+}
+
+void bk_run_catalog_free(run_ctx *ctx)
+{
+    bk_catalog_free(ctx->catalog);
+    free(ctx->rate_v);
+    free(ctx->rate_a);
+    free(ctx->catalog_modes);
+    free(ctx->scene.above);
+    ctx->scene.above = NULL;
+    bk_catalog_state *s = &ctx->catalog_state;
+    free(s->x_onset);
+    free(s->first_force);
+    free(s->last_force);
+    free(s->involved);
+    free(s->slipping);
+}
+
+static int emit(run_ctx *ctx, const bk_event *event)
+{
+    ctx->events++;
+    int rc = bk_run_count_bytes(ctx, BK_EVENT_RECORD_BYTES, event->t_end);
+    if (rc == BK_OK && ctx->sink && ctx->sink->event) {
+        rc = ctx->sink->event(ctx->sink->self, event, ctx->err);
+        if (rc != BK_OK)
+            rc = rc < 0 ? rc : BK_ERR_SINK;
+    }
+    return rc;
+}
+
+int bk_run_catalog_transition(run_ctx *ctx, const bk_transition *transition)
+{
+    if (!ctx->catalog)
+        return BK_OK;
+    bk_event event;
+    int done = 0;
+    if (bk_catalog_add(ctx->catalog, transition, &event, &done) != BK_OK)
+        return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the event catalog at t = %.17g s",
+                       transition->t);
+    return done ? emit(ctx, &event) : BK_OK;
+}
+
+int bk_run_catalog_crossing(run_ctx *ctx, double t, size_t i)
+{
+    bk_scene *scene = &ctx->scene;
+    if (ctx->n_instant > 0 && t != ctx->t_instant) {
+        int rc = bk_run_flush_instant(ctx);
+        if (rc != BK_OK)
+            return rc;
+    }
+    double driver_pos = bk_driver_position(&ctx->model->driver, t);
+    int8_t from = catalog_mode(ctx, i);
+    scene->above[i] = (uint8_t)!scene->above[i];
+    bk_transition crossing = {
+        .t = t,
+        .block = (int32_t)i,
+        .from = from,
+        .to = catalog_mode(ctx, i),
+        .x = scene->x[i],
+        .v = scene->v[i],
+        .force = bk_scene_applied_force(scene, i, driver_pos),
+    };
+    return bk_run_catalog_transition(ctx, &crossing);
+}
+
+int bk_run_catalog_finish(run_ctx *ctx, double t)
+{
+    if (!ctx->catalog)
+        return BK_OK;
+    bk_event event;
+    ctx->t_catalog = t;
+    if (bk_catalog_finish(ctx->catalog, t, ctx->scene.x, applied_force, ctx, &event) == 1)
+        return emit(ctx, &event);
+    return BK_OK;
+}
+
+bk_catalog_state *bk_run_catalog_save(run_ctx *ctx)
+{
+    if (!ctx->catalog)
+        return NULL;
+    bk_catalog_save(ctx->catalog, &ctx->catalog_state);
+    ctx->catalog_state.events = ctx->events;
+    return &ctx->catalog_state;
+}
+
+/* ------------------------------------------------------------ largest slip rate --- */
+
+/* d|v|/dt of slipping block i for the island's vector y at t (from rest: along its mode). */
+static double speed_rate(const run_island *isl, size_t i, double t, const double *y)
+{
+    const bk_scene *scene = isl->island.scene;
+    double v = y[scene->slot[i] + 1], dir = (double)scene->mode[i];
+    double accel = dir * bk_island_slip_acceleration(&isl->island, i, t, y);
+    return v > 0.0 ? accel : v < 0.0 ? -accel : dir * accel;
+}
+
+void bk_run_catalog_island_start(run_ctx *ctx, const run_island *isl)
+{
+    if (!ctx->catalog)
+        return;
+    const bk_scene *scene = &ctx->scene;
+    const bk_island *island = &isl->island;
+    double fastest = 0.0;
+    for (size_t k = 0; k < island->n_active; ++k) {
+        size_t i = island->active[k];
+        ctx->rate_v[i] = isl->y[scene->slot[i] + 1];
+        ctx->rate_a[i] = speed_rate(isl, i, island->t_ref, isl->y);
+        fastest = fmax(fastest, fabs(ctx->rate_v[i]));
+    }
+    bk_catalog_slip_rate(ctx->catalog, fastest);
+}
+
+/* The largest value of the cubic with values u0, u1 and slopes d0 > 0 > d1 at 0 and h. */
+static double hermite_peak(double u0, double d0, double u1, double d1, double h)
+{
+    /* p(s) = u0 + d0 h s + c2 s^2 + c3 s^3 on s in [0, 1]. */
+    double c2 = 3.0 * (u1 - u0) - (2.0 * d0 + d1) * h;
+    double c3 = 2.0 * (u0 - u1) + (d0 + d1) * h;
+    double a = 3.0 * c3, b = 2.0 * c2, c = d0 * h; /* p'(s) = a s^2 + b s + c */
+    double s;
+    if (fabs(a) < 1e-14 * (fabs(b) + fabs(c)))
+        s = -c / b;
+    else {
+        double disc = sqrt(fmax(b * b - 4.0 * a * c, 0.0));
+        /* p' > 0 at 0 and < 0 at 1: its one zero in between. */
+        double q = -0.5 * (b + copysign(disc, b));
+        double s1 = q / a, s2 = c / q;
+        s = s1 > 0.0 && s1 < 1.0 ? s1 : s2;
+    }
+    s = fmin(fmax(s, 0.0), 1.0);
+    return u0 + s * (d0 * h + s * (c2 + s * c3));
+}
+
+typedef struct peak_probe {
+    run_ctx *ctx;
+    run_island *isl;
+    size_t block;
+    int status;
+} peak_probe;
+
+static double peak_function(double t, void *user)
+{
+    peak_probe *p = user;
+    int rc = p->ctx->backend->interpolate(p->isl->solver, t, p->isl->y_probe, p->ctx->err);
+    if (rc != BK_OK) {
+        p->status = rc;
+        return 0.0;
+    }
+    return speed_rate(p->isl, p->block, t, p->isl->y_probe);
+}
+
+int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl)
+{
+    if (!ctx->catalog || bk_catalog_max_slip_rate(ctx->catalog) < 0.0)
+        return BK_OK;
+    const bk_scene *scene = &ctx->scene;
+    const bk_island *island = &isl->island;
+    double lo, hi;
+    ctx->backend->last_step(isl->solver, &lo, &hi);
+    hi = isl->t_reached;
+    const double *y = isl->y;
+    /* A stop found inside the step ends the trajectory there. */
+    if (isl->pending && isl->t_event < hi) {
+        hi = isl->t_event;
+        int rc = ctx->backend->interpolate(isl->solver, hi, isl->y_probe, ctx->err);
+        if (rc != BK_OK)
+            return rc;
+        y = isl->y_probe;
+    }
+    if (lo < island->t_ref)
+        lo = island->t_ref;
+    double fastest = 0.0, best_estimate = -1.0;
+    size_t best = SIZE_MAX;
+    for (size_t k = 0; k < island->n_active; ++k) {
+        size_t i = island->active[k];
+        double v = y[scene->slot[i] + 1], rate = speed_rate(isl, i, hi, y);
+        fastest = fmax(fastest, fabs(v));
+        if (ctx->rate_a[i] > 0.0 && rate < 0.0 && hi > lo) {
+            double estimate = hermite_peak(fabs(ctx->rate_v[i]), ctx->rate_a[i], fabs(v), rate, hi - lo);
+            if (estimate > best_estimate) {
+                best_estimate = estimate;
+                best = i;
+            }
+        }
+        ctx->rate_v[i] = v;
+        ctx->rate_a[i] = rate;
+    }
+    bk_catalog_slip_rate(ctx->catalog, fastest);
+    if (best == SIZE_MAX || best_estimate <= bk_catalog_max_slip_rate(ctx->catalog))
+        return BK_OK;
+    peak_probe probe = {ctx, isl, best, BK_OK};
+    gsl_function fn = {peak_function, &probe};
+    double f_lo = peak_function(lo, &probe), f_hi = peak_function(hi, &probe);
+    double t_peak = hi;
+    if (probe.status == BK_OK && f_lo > 0.0 && f_hi < 0.0)
+        t_peak = bk_run_zero_after(ctx, &fn, lo, hi);
+    if (probe.status != BK_OK)
+        return probe.status;
+    int rc = ctx->backend->interpolate(isl->solver, t_peak, isl->y_probe, ctx->err);
+    if (rc != BK_OK)
+        return rc;
+    bk_catalog_slip_rate(ctx->catalog, isl->y_probe[scene->slot[best] + 1]);
+    return BK_OK;
+}
