@@ -142,6 +142,7 @@ int bk_run_catalog_crossing(run_ctx *ctx, double t, size_t i)
     double driver_pos = bk_driver_position(&ctx->model->driver, t);
     int8_t from = catalog_mode(ctx, i);
     scene->above[i] = (uint8_t)!scene->above[i];
+    ctx->steps_since_row = 0; /* progress, as a transition is, for the hang guard */
     bk_transition crossing = {
         .t = t,
         .block = (int32_t)i,

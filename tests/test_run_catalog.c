@@ -370,6 +370,63 @@ static void test_threshold_law(void **state)
     assert_non_null(strstr(err.message, "slip_rate_threshold: applies to laws without a stuck state"));
 }
 
+/* Sizes (magnitudes, binned) of the complete events of a run of the 100-block Carlson-Langer
+ * ring. */
+static double *ring_sizes(const char *const *overrides, size_t n_overrides, size_t *count)
+{
+    bk_config *c = load("configs/chains/carlson_langer_100.ini", 1, overrides, n_overrides);
+    catalog_sink s = {0};
+    run_into(c, &s);
+    double *p = malloc((s.n_events ? s.n_events : 1) * sizeof *p);
+    assert_non_null(p);
+    size_t n = 0;
+    for (size_t k = 0; k < s.n_events; ++k)
+        if (s.events[k].complete)
+            p[n++] = floor(s.events[k].magnitude / 0.1 + 0.5); /* bins of 0.1 */
+    sink_free(&s);
+    bk_config_free(c);
+    *count = n;
+    return p;
+}
+
+/* The ring is chaotic: two back-ends (or tolerances) part ways event by event, but draw their
+ * event sizes from one distribution.  A two-sample Kolmogorov-Smirnov test on the sizes
+ * must not reject that at the 1 % level, and must reject it (p < 1e-3) for a ring with a
+ * larger drop at the onset of slip (sigma 0.01 -> 0.1), which shifts every size. Sizes are
+ * magnitudes in bins of 0.1, as bksim stats bins them: the single-block events, a third of
+ * all, have one potency in exact arithmetic, and their rounding would otherwise make a
+ * spurious step in the distribution. */
+static void test_chaotic_ring_sizes_agree_across_backends(void **state)
+{
+    (void)state;
+    static const char *const rk8pd[] = {"run.t_end=1000", "solver.method=gsl_rk8pd", "solver.rtol=1e-8"};
+    static const char *const rkf45[] = {"run.t_end=1000", "solver.method=gsl_rkf45", "solver.rtol=1e-6"};
+    static const char *const dropped[] = {"run.t_end=1000", "solver.method=gsl_rk8pd", "solver.rtol=1e-8",
+                                         "friction.sigma=0.1"};
+    size_t n1, n2, n3;
+    double *p1 = ring_sizes(rk8pd, 3, &n1);
+    double *p2 = ring_sizes(rkf45, 3, &n2);
+    double *p3 = ring_sizes(dropped, 4, &n3);
+    assert_true(n1 > 300 && n2 > 300 && n3 > 100);
+    /* Trajectories differ: the catalogs are not the same list. */
+    int same = n1 == n2;
+    for (size_t k = 0; same && k < n1; ++k)
+        same = p1[k] == p2[k];
+    assert_false(same);
+    bk_ks_result agree, differ;
+    bk_error err = {0};
+    assert_int_equal(bk_ks_two_sample(p1, n1, p2, n2, &agree, &err), BK_OK);
+    assert_int_equal(bk_ks_two_sample(p1, n1, p3, n3, &differ, &err), BK_OK);
+    print_message("KS on event sizes: gsl_rk8pd at rtol 1e-8 (%zu events) vs gsl_rkf45 at 1e-6 (%zu): D = %.4f, p = %.3g; "
+                  "sigma 0.01 vs 0.1 (%zu): D = %.4f, p = %.3g\n",
+                  n1, n2, agree.d, agree.p, n3, differ.d, differ.p);
+    assert_true(agree.p > 0.01);
+    assert_true(differ.p < 1e-3);
+    free(p1);
+    free(p2);
+    free(p3);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -379,6 +436,7 @@ int main(void)
         cmocka_unit_test(test_uniform_ring_closed_form),
         cmocka_unit_test(test_max_slip_rate_chain),
         cmocka_unit_test(test_threshold_law),
+        cmocka_unit_test(test_chaotic_ring_sizes_agree_across_backends),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -33,6 +33,13 @@ int bk_h5_verify(const char *path, bk_error *err);
 int bk_h5_export(const char *path, const char *datasets, long block, int transitions,
                  FILE *out, bk_error *err);
 
+/* The /events catalog as TSV on out: a '#' header naming the twelve fields with units
+ * (t_start[s] ... complete[1]), then one tab-separated row per event in table order, doubles
+ * as %.17g (a zero-potency event's magnitude prints as -inf), integers as %d; read one
+ * chunk of rows at a time.  A file without /events, or whose /events lacks one of bksim's
+ * event fields, is an error that names the file and /events. */
+int bk_h5_export_events(const char *path, FILE *out, bk_error *err);
+
 /* Read a whole numeric dataset as doubles (row-major, rows x cols; cols = 1 for 1-D).
  * *data is malloc'ed. */
 int bk_h5_read_doubles(const char *path, const char *dataset, double **data, size_t *rows,

@@ -30,6 +30,8 @@ static const char *const usage_text =
     "  info OUT.h5          summarise an output file\n"
     "  export OUT.h5 [--datasets a,b,...] [--block I] [--transitions]\n"
     "                       print columns for gnuplot and shell tools\n"
+    "  export OUT.h5 --events\n"
+    "                       print the event catalog /events as TSV\n"
     "  stats FILE [--mc auto|VALUE] [--bin DM] [--json] [--tsv DIR]\n"
     "                       earthquake statistics of the catalog /events in FILE\n"
     "  keys                 print the config key reference (Markdown)\n"
@@ -69,12 +71,16 @@ static const char *const info_help =
 
 static const char *const export_help =
     "usage: bksim export OUT.h5 [--datasets a,b,...] [--block I] [--transitions]\n"
+    "       bksim export OUT.h5 --events\n"
     "\n"
     "Prints whitespace-separated columns with a '#' header (names and units).\n"
     "  --datasets LIST   comma-separated dataset names (default time,driver,x,v,friction,\n"
     "                    cof,mode); per-block datasets give one column per block\n"
     "  --block I         only block I (0-based) of the per-block datasets\n"
-    "  --transitions     print the /transitions table instead\n";
+    "  --transitions     print the /transitions table instead\n"
+    "  --events          print the event catalog /events instead, tab-separated: one row\n"
+    "                    per event, every field (t_start ... complete); on a ring\n"
+    "                    left > right when the extent wraps past block 0\n";
 
 static const char *const stats_help =
     "usage: bksim stats FILE [--mc auto|VALUE] [--bin DM] [--json] [--tsv DIR]\n"
@@ -396,7 +402,7 @@ static int cmd_export(int argc, char **argv)
     }
     const char *path = NULL, *datasets = NULL;
     long block = -1;
-    int transitions = 0;
+    int transitions = 0, events = 0;
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
         if (strcmp(a, "--datasets") == 0 && i + 1 < argc) {
@@ -412,6 +418,8 @@ static int cmd_export(int argc, char **argv)
                 return usage_error("export", "--block needs a block index >= 0, got '%s'", text);
         } else if (strcmp(a, "--transitions") == 0) {
             transitions = 1;
+        } else if (strcmp(a, "--events") == 0) {
+            events = 1;
         } else if (a[0] == '-') {
             return usage_error("export", "unknown or incomplete option '%s'", a);
         } else if (!path) {
@@ -422,8 +430,13 @@ static int cmd_export(int argc, char **argv)
     }
     if (!path)
         return usage_error("export", "%s", "missing OUT.h5");
+    if (events && (datasets || block >= 0 || transitions))
+        return usage_error("export", "%s", "--events prints the whole catalog: it takes none "
+                                           "of --datasets, --block, --transitions");
     bk_error err = {0};
-    if (bk_h5_export(path, datasets, block, transitions, stdout, &err) != BK_OK) {
+    int rc = events ? bk_h5_export_events(path, stdout, &err)
+                    : bk_h5_export(path, datasets, block, transitions, stdout, &err);
+    if (rc != BK_OK) {
         fprintf(stderr, "%s\n", err.message);
         return EXIT_RUN_FAILED;
     }

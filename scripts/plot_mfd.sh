@@ -1,0 +1,180 @@
+#!/usr/bin/env bash
+# The event catalog /events of a run, as two figures:
+#   OUTDIR/<stem>_mfd.<fmt>        magnitude-frequency distribution: incremental (points) and
+#                                  cumulative (line and points) counts per magnitude bin on a
+#                                  log scale, the fitted Gutenberg-Richter law
+#                                  log10 N = a - b M from Mc up, b and its error, Mc marked;
+#   OUTDIR/<stem>_spacetime.<fmt>  every event's extent (blocks left..right) at its start
+#                                  time, coloured by magnitude; an event that wraps past
+#                                  block 0 on a ring (left > right) is drawn as two segments.
+# The statistics are `bksim stats FILE` (complete events only; Mc by maximum curvature + 0.2,
+# bins of 0.1); the events are `bksim export FILE --events` (every row, running ones too).
+# <stem> is FILE's name without .h5 (and .part); OUTDIR defaults to FILE's directory.
+# Optional XRANGE=lo:hi (s) zooms the space-time plot in time.
+# usage: plot_mfd.sh [--format png|pdf|svg] [-o OUTDIR] FILE.h5
+set -euo pipefail
+me=plot_mfd.sh
+bksim=${BKSIM:-./bksim}
+# Run from elsewhere, use the build next to this script.
+[ -n "${BKSIM:-}" ] || [ -x "$bksim" ] || bksim="$(dirname "$0")/../bksim"
+
+usage() { echo "usage: $me [--format png|pdf|svg] [-o OUTDIR] FILE.h5" >&2; exit 2; }
+fail() { echo "$me: $*" >&2; exit 1; }
+
+format=png; outdir=""; file=""
+while [ $# -gt 0 ]; do
+    case $1 in
+        --format) [ $# -ge 2 ] || usage; format=$2; shift 2 ;;
+        --format=*) format=${1#--format=}; shift ;;
+        -o|--output) [ $# -ge 2 ] || usage; outdir=$2; shift 2 ;;
+        -h|--help) sed -n '2,14s/^# \{0,1\}//p' "$0"; exit 0 ;;
+        -*) echo "$me: unknown option '$1'" >&2; usage ;;
+        *) [ -z "$file" ] || { echo "$me: unexpected argument '$1'" >&2; usage; }
+           file=$1; shift ;;
+    esac
+done
+[ -n "$file" ] || { echo "$me: missing FILE.h5" >&2; usage; }
+case $format in
+    png) terminal="pngcairo size 1200,800 font 'Sans,13'" ;;
+    pdf) terminal="pdfcairo size 10in,6.67in font 'Sans,11' linewidth 0.6" ;;
+    svg) terminal="svg size 1200,800 font 'Sans,13' background rgb 'white'" ;;
+    *) echo "$me: --format must be png, pdf or svg, got '$format'" >&2; usage ;;
+esac
+[ -e "$file" ] || fail "$file: no such file"
+[ -f "$file" ] || fail "$file: not a regular file"
+command -v gnuplot >/dev/null 2>&1 || fail "needs gnuplot (Debian package gnuplot-nox)"
+[ -x "$bksim" ] || fail "no bksim binary at $bksim (build it with make, or set BKSIM)"
+outdir=${outdir:-$(dirname "$file")}
+mkdir -p "$outdir" || fail "$outdir: cannot create the output directory"
+stem=$(basename "$file"); stem=${stem%.part}; stem=${stem%.h5}
+mfd_out="$outdir/${stem}_mfd.$format"
+st_out="$outdir/${stem}_spacetime.$format"
+
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+"$bksim" export "$file" --events > "$tmp/events.tsv" 2> "$tmp/err" ||
+    fail "$(cat "$tmp/err")"
+"$bksim" stats "$file" --json --tsv "$tmp/stats" > "$tmp/stats.json" 2> "$tmp/err" ||
+    fail "$(cat "$tmp/err")"
+
+# A top-level value of the JSON report (the first occurrence of the key): a number, or
+# null when bksim could not estimate it; json_note gives a *_note string.
+json() { grep -o "\"$1\": [^,}]*" "$tmp/stats.json" | head -n 1 | sed 's/^[^:]*: //'; }
+json_note() { grep -o "\"$1\": \"[^\"]*\"" "$tmp/stats.json" | head -n 1 | sed 's/^[^:]*: "//; s/"$//'; }
+n_rows=$(json n_rows); n_events=$(json n_events)
+n_incomplete=$(json n_incomplete); n_nonfinite=$(json n_nonfinite)
+n_mc=$(json n_above_mc); mc=$(json mc); b=$(json b_value); b_err=$(json b_value_error); a=$(json a_value)
+dm=$(json bin); m_max=$(json magnitude_max)
+[ "$n_rows" -gt 0 ] || fail "$file: /events is empty: nothing to plot"
+
+# The chain's length (bksim info; its exit status says whether the run finished, which
+# does not matter here), else the largest block an event reached.
+n_blocks=$({ "$bksim" info "$file" 2>/dev/null || true; } | awk '$1 == "n_blocks" {print $2; exit}')
+if ! [[ $n_blocks =~ ^[0-9]+$ ]]; then
+    n_blocks=$(awk -F'\t' '!/^#/ {m = $5 > m ? $5 : m; m = $6 > m ? $6 : m} END {print m + 1}' \
+        "$tmp/events.tsv")
+fi
+
+# Text inside a single-quoted gnuplot string (a quote doubled).
+gpq() { local s=$1 q="'"; printf '%s' "${s//$q/$q$q}"; }
+# Numbers as text: a minus sign, not a hyphen.
+num() { LC_ALL=C printf "%.${2}${3:-f}" "$1" | sed 's/^-/−/'; }
+
+# ------------------------------------------------------- (a) magnitude-frequency ---
+left_out=""
+[ "$n_incomplete" -eq 0 ] || left_out="$n_incomplete still running at the end"
+[ "$n_nonfinite" -eq 0 ] || left_out="${left_out:+$left_out, }$n_nonfinite of zero potency (M = −∞)"
+subtitle="$n_events complete events in bins of ΔM = $dm${left_out:+; left out: $left_out}"
+if [ "$b" != null ]; then
+    b_err_text=""
+    [ "$b_err" = null ] || b_err_text=" ± $(num "$b_err" 3)"
+    fit_title="Gutenberg–Richter fit for M ≥ Mc: log₁₀ N = a − b M, b = $(num "$b" 3)${b_err_text}, a = $(num "$a" 3) ($n_mc events)"
+    fit_plot=", [x=$mc:$m_max + $dm/2] 10**($a - $b*x) with lines lw 2.5 lc rgb '#d62728' title '$fit_title'"
+else
+    fit_plot=", NaN with lines lw 2.5 lc rgb '#d62728' title 'no Gutenberg–Richter fit: $(gpq "$(json_note b_value_note)")'"
+fi
+mc_arrow=""; mc_plot=""
+if [ "$mc" != null ]; then
+    mc_arrow="set arrow 1 from $mc, graph 0 to $mc, graph 1 nohead dt 2 lw 2 lc rgb '#555555' back"
+    mc_plot=", NaN with lines dt 2 lw 2 lc rgb '#555555' title 'completeness magnitude Mc = $(num "$mc" 6 g)'"
+fi
+if [ -s "$tmp/stats/mfd.tsv" ]; then
+# The magnitude axis covers every bin and Mc; the count axis from below 1 to twice the
+# number of events (at least 10).
+mfd_x=$(awk -v mc="$mc" -v dm="$dm" '!/^#/ {if (!n++) lo = hi = $1; if ($1 < lo) lo = $1; if ($1 > hi) hi = $1}
+    END {if (mc != "null") {if (mc < lo) lo = mc; if (mc > hi) hi = mc}
+         printf "%.10g:%.10g", lo - dm, hi + dm}' "$tmp/stats/mfd.tsv")
+mfd_ymax=$(awk '!/^#/ && $3 > m {m = $3} END {print (2 * m > 10 ? 2 * m : 10)}' \
+           "$tmp/stats/mfd.tsv")
+gnuplot <<GP || fail "gnuplot failed drawing $mfd_out"
+set encoding utf8
+set terminal $terminal noenhanced
+set output '$(gpq "$mfd_out")'
+set title '$(gpq "$stem"): magnitude-frequency distribution' . "\n" . '$(gpq "$subtitle")'
+set grid lc rgb '#c0c0c0' lw 1 dt 3
+set xlabel 'magnitude M'
+set ylabel 'number of events N'
+set xrange [$mfd_x]
+set logscale y
+set format y '%g'
+set yrange [0.5:$mfd_ymax]
+set mytics 10
+set key outside below center vertical Left reverse width -4 spacing 1.2
+$mc_arrow
+plot '$tmp/stats/mfd.tsv' using 1:(\$3 > 0 ? \$3 : NaN) with linespoints pt 7 ps 0.9 lw 1.5 lc rgb '#1f77b4' title 'cumulative N(≥ M)', \
+     '' using 1:(\$2 > 0 ? \$2 : NaN) with points pt 6 ps 1.3 lw 1.5 lc rgb '#ff7f0e' title 'incremental N(M), per bin' \
+     $fit_plot $mc_plot
+GP
+else
+    echo "$me: $file: no complete event with a finite magnitude: no $mfd_out" >&2
+fi
+
+# ------------------------------------------------------------- (b) space-time ---
+# Segments t, from, to, magnitude, the blocks as cells [i - 1/2, i + 1/2]; a wrapping event
+# gives two.  Sorted by magnitude, so that the larger events are drawn on top.  Events of
+# zero potency (magnitude -inf) go to a file of their own, drawn grey.
+awk -F'\t' -v n="$n_blocks" -v seg="$tmp/seg.unsorted" -v zero="$tmp/zero.dat" '
+    BEGIN { printf "" > seg; printf "" > zero }
+    /^#/ { next }
+    { out = ($9 ~ /inf|nan/) ? zero : seg
+      if ($5 <= $6) print $1, $5 - 0.5, $6 + 0.5, $9 > out
+      else { print $1, $5 - 0.5, n - 0.5, $9 > out; print $1, -0.5, $6 + 0.5, $9 > out } }' \
+    "$tmp/events.tsv"
+sort -g -k4,4 "$tmp/seg.unsorted" > "$tmp/seg.dat"
+n_wrap=$(awk -F'\t' '!/^#/ && $5 > $6' "$tmp/events.tsv" | wc -l)
+n_zero=$(awk -F'\t' '!/^#/ && $9 ~ /inf|nan/' "$tmp/events.tsv" | wc -l)
+t_range=$(awk -F'\t' '!/^#/ {if (!n++) lo = hi = $1; if ($1 < lo) lo = $1; if ($1 > hi) hi = $1}
+                      END {d = hi > lo ? 0.01 * (hi - lo) : 1; printf "%.17g:%.17g", lo - d, hi + d}' \
+          "$tmp/events.tsv")
+m_range=$(awk '{if (!n++) lo = hi = $4; if ($4 < lo) lo = $4; if ($4 > hi) hi = $4}
+               END {if (!n) lo = hi = 0; if (hi - lo < 0.1) {c = (lo + hi) / 2; lo = c - 0.05; hi = c + 0.05}
+                    printf "%.17g:%.17g", lo, hi}' \
+          "$tmp/seg.dat")
+zero_plot=""
+[ "$n_zero" -eq 0 ] ||
+    zero_plot=", '$tmp/zero.dat' using 1:2:(0):(\$3 - \$2) with vectors nohead lw 2 lc rgb '#999999' title 'zero potency (M = −∞)'"
+wrap_note=""
+[ "$n_wrap" -eq 0 ] || wrap_note=", $n_wrap wrapping past block 0 (drawn as two segments)"
+gnuplot <<GP || fail "gnuplot failed drawing $st_out"
+set encoding utf8
+set terminal $terminal noenhanced
+set output '$(gpq "$st_out")'
+set title '$(gpq "$stem"): events in space and time' . "\n" . \
+          '$n_rows events$wrap_note; a segment spans blocks left..right at t_start'
+set xlabel 'event start time t_start [s]'
+set ylabel 'block'
+set xrange [${XRANGE:-$t_range}]
+set yrange [-0.5 : $n_blocks - 0.5]
+set ytics out nomirror
+$(if [ "$n_blocks" -le 12 ]; then echo "set ytics 1"; else echo "set mytics"; fi)
+set grid back lc rgb '#c0c0c0' lw 1 dt 3
+set cbrange [$m_range]
+set cblabel 'magnitude M'
+set rmargin at screen 0.84
+set colorbox vertical user origin screen 0.865, screen 0.2 size screen 0.025, screen 0.65
+set palette defined (0 '#30123b', 0.15 '#4662d7', 0.3 '#36aaf9', 0.45 '#1ae4b6', 0.6 '#72fe5e', 0.75 '#c8ef34', 0.85 '#faba39', 0.93 '#f66b19', 1 '#7a0403')
+set key outside below center horizontal
+${zero_plot:+set bmargin 5.5}
+plot '$tmp/seg.dat' using 1:2:(0):(\$3 - \$2):4 with vectors nohead lw 2 lc palette notitle $zero_plot
+GP
+echo "$mfd_out"
+echo "$st_out"
