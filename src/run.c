@@ -400,3 +400,14 @@ done:
     free_ctx(&ctx);
     return rc;
 }
+
+const double *bk_run_probe_state(bk_block_probe *probe, double t)
+{
+    run_ctx *ctx = probe->ctx;
+    int rc = ctx->backend->interpolate(probe->isl->solver, t, probe->isl->y_probe, ctx->err);
+    if (rc != BK_OK) {
+        probe->status = rc;
+        return NULL;
+    }
+    return probe->isl->y_probe;
+}

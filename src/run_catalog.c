@@ -223,22 +223,11 @@ static double hermite_peak(double u0, double d0, double u1, double d1, double h)
     return u0 + s * (d0 * h + s * (c2 + s * c3));
 }
 
-typedef struct peak_probe {
-    run_ctx *ctx;
-    run_island *isl;
-    size_t block;
-    int status;
-} peak_probe;
-
 static double peak_function(double t, void *user)
 {
-    peak_probe *p = user;
-    int rc = p->ctx->backend->interpolate(p->isl->solver, t, p->isl->y_probe, p->ctx->err);
-    if (rc != BK_OK) {
-        p->status = rc;
-        return 0.0;
-    }
-    return speed_rate(p->isl, p->block, t, p->isl->y_probe);
+    bk_block_probe *p = user;
+    const double *y = bk_run_probe_state(p, t);
+    return y ? speed_rate(p->isl, p->block, t, y) : 0.0;
 }
 
 int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl)
@@ -280,7 +269,7 @@ int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl)
     bk_catalog_slip_rate(ctx->catalog, fastest);
     if (best == SIZE_MAX || best_estimate <= bk_catalog_max_slip_rate(ctx->catalog))
         return BK_OK;
-    peak_probe probe = {ctx, isl, best, BK_OK};
+    bk_block_probe probe = {ctx, isl, best, BK_OK};
     gsl_function fn = {peak_function, &probe};
     double f_lo = peak_function(lo, &probe), f_hi = peak_function(hi, &probe);
     double t_peak = hi;

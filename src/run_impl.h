@@ -131,6 +131,15 @@ double bk_run_stop_time(const run_ctx *ctx);
  * upper end of the final bracket, past the zero as at a root an integrator reports; hi when
  * GSL refuses the bracket. */
 double bk_run_zero_after(run_ctx *ctx, gsl_function *f, double lo, double hi);
+/* A function of one block on an island's last-step interpolant, as Brent evaluates it. */
+typedef struct bk_block_probe {
+    run_ctx *ctx;
+    run_island *isl;
+    size_t block;
+    int status; /* the first failure of the back-end's interpolation */
+} bk_block_probe;
+/* The island's vector at t (in isl->y_probe); NULL, with status set, when the back-end fails. */
+const double *bk_run_probe_state(bk_block_probe *probe, double t);
 
 /* ---- run_islands.c ---- */
 int bk_run_islands_init(run_ctx *ctx);

@@ -490,26 +490,16 @@ int bk_run_partition_all(run_ctx *ctx, double t)
 
 /* ------------------------------------------------------------- island events --- */
 
-typedef struct stop_probe {
-    run_ctx *ctx;
-    run_island *isl;
-    size_t block;
-    int status;
-} stop_probe;
-
 /* The stop root function of a slipping block on the island's last step's interpolant. */
 static double stop_function(double t, void *user)
 {
-    stop_probe *probe = user;
-    run_ctx *ctx = probe->ctx;
-    const bk_scene *scene = &ctx->scene;
+    bk_block_probe *probe = user;
+    const bk_scene *scene = &probe->ctx->scene;
     size_t i = probe->block;
-    int rc = ctx->backend->interpolate(probe->isl->solver, t, probe->isl->y_probe, ctx->err);
-    if (rc != BK_OK) {
-        probe->status = rc;
+    const double *y = bk_run_probe_state(probe, t);
+    if (!y)
         return 0.0;
-    }
-    double slip_rate = (double)scene->mode[i] * probe->isl->y_probe[scene->slot[i] + 1];
+    double slip_rate = (double)scene->mode[i] * y[scene->slot[i] + 1];
     double since = t - scene->t_switch[i];
     if (scene->from_rest[i] && since <= 0.0)
         return 1.0; /* the limit s a > 0 at the start of a slip from rest */
@@ -523,7 +513,7 @@ static int locate_hidden_stop(run_ctx *ctx, run_island *isl, size_t i, double t_
     ctx->backend->last_step(isl->solver, &lo, &hi);
     if (lo < isl->island.t_ref)
         lo = isl->island.t_ref;
-    stop_probe probe = {ctx, isl, i, BK_OK};
+    bk_block_probe probe = {ctx, isl, i, BK_OK};
     gsl_function fn = {stop_function, &probe};
     double f_lo = stop_function(lo, &probe), f_hi = stop_function(t_root, &probe);
     if (probe.status != BK_OK)
