@@ -45,7 +45,6 @@ int bk_run_catalog_init(run_ctx *ctx, const bk_checkpoint *from)
                                      config->catalog.magnitude_offset);
     ctx->rate_v = malloc(n * sizeof *ctx->rate_v);
     ctx->rate_a = malloc(n * sizeof *ctx->rate_a);
-    ctx->catalog_modes = malloc(n * sizeof *ctx->catalog_modes);
     int creeping = 0;
     for (size_t i = 0; i < n; ++i)
         creeping |= !scene->can_stick[i];
@@ -53,7 +52,7 @@ int bk_run_catalog_init(run_ctx *ctx, const bk_checkpoint *from)
         scene->slip_threshold = config->catalog.slip_rate_threshold;
         scene->above = calloc(n, sizeof *scene->above);
     }
-    if (!ctx->catalog || !ctx->rate_v || !ctx->rate_a || !ctx->catalog_modes || (creeping && !scene->above))
+    if (!ctx->catalog || !ctx->rate_v || !ctx->rate_a || (creeping && !scene->above))
         return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the event catalog of %zu blocks", n);
     if (ctx->checkpoint_interval > 0.0) {
         bk_catalog_state *s = &ctx->catalog_state;
@@ -77,16 +76,19 @@ int bk_run_catalog_init(run_ctx *ctx, const bk_checkpoint *from)
     }
     /* Blocks that move at t = 0 slip from the start; resting ones start slipping through
      * transitions at t = 0, which the builder then sees. */
+    int8_t *modes = malloc(n * sizeof *modes);
+    if (!modes)
+        return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the event catalog of %zu blocks", n);
     for (size_t i = 0; i < n; ++i) {
         if (scene->above)
             scene->above[i] = !scene->can_stick[i] && fabs(scene->v[i]) > scene->slip_threshold;
-        ctx->catalog_modes[i] = scene->can_stick[i] ? (scene->v[i] > 0.0   ? (int8_t)BK_MODE_SLIP_POS
-                                                       : scene->v[i] < 0.0 ? (int8_t)BK_MODE_SLIP_NEG
-                                                                           : (int8_t)BK_MODE_STICK)
-                                                    : catalog_mode(ctx, i);
+        int slips = scene->can_stick[i] ? scene->v[i] != 0.0 : scene->above[i];
+        modes[i] = slips ? (int8_t)BK_MODE_SLIP_POS : (int8_t)BK_MODE_STICK; /* the builder asks no more */
     }
     ctx->t_catalog = 0.0;
-    if (bk_catalog_begin(ctx->catalog, 0.0, ctx->catalog_modes, scene->x, scene->v, applied_force, ctx) != BK_OK)
+    int rc = bk_catalog_begin(ctx->catalog, 0.0, modes, scene->x, scene->v, applied_force, ctx);
+    free(modes);
+    if (rc != BK_OK)
         return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the event catalog");
     return BK_OK;
 }
@@ -96,7 +98,6 @@ void bk_run_catalog_free(run_ctx *ctx)
     bk_catalog_free(ctx->catalog);
     free(ctx->rate_v);
     free(ctx->rate_a);
-    free(ctx->catalog_modes);
     free(ctx->scene.above);
     ctx->scene.above = NULL;
     bk_catalog_state *s = &ctx->catalog_state;

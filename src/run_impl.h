@@ -115,7 +115,6 @@ typedef struct run_ctx {
     long events;          /* events completed */
     double t_catalog;     /* s, where the builder's force callback evaluates */
     double *rate_v, *rate_a; /* per block: v and d|v|/dt at its island's last step end */
-    int8_t *catalog_modes;   /* scratch: the modes the builder begins with */
     bk_catalog_state catalog_state; /* what a checkpoint saves (arrays only with checkpoints) */
 } run_ctx;
 

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "bk_test.h"
+#include "capacity.h"
 #include "bksim/bksim.h"
 #include "exact_single.h"
 #include "same_output.h"
@@ -19,18 +20,17 @@ typedef struct catalog_sink {
     size_t n_events, cap_events;
     double *x_last;           /* the last row's positions */
     double t_last, driver_last;
-    double *row_t, *row_speed; /* each row's time and largest |v| */
+    struct row {
+        double t, speed; /* s; the largest |v| of the row, m/s */
+    } *rows;
     size_t n_rows, cap_rows;
 } catalog_sink;
 
-static void *grow(void *array, size_t *cap, size_t need, size_t size)
+/* Room for one more item (a failed allocation fails the test). */
+static void *grow(void *items, size_t *capacity, size_t count, size_t size)
 {
-    if (need <= *cap)
-        return array;
-    size_t cap2 = *cap ? 2 * *cap : 64;
-    void *grown = realloc(array, cap2 * size);
+    void *grown = bk_grow_array(items, capacity, count + 1, size, 64);
     assert_non_null(grown);
-    *cap = cap2;
     return grown;
 }
 
@@ -46,11 +46,8 @@ static int on_sample(void *self, const bk_sample *s, bk_error *err)
     double speed = 0.0;
     for (size_t i = 0; i < s->n_blocks; ++i)
         speed = fmax(speed, fabs(s->v[i]));
-    size_t cap = c->cap_rows;
-    c->row_t = grow(c->row_t, &c->cap_rows, c->n_rows + 1, sizeof *c->row_t);
-    c->row_speed = grow(c->row_speed, &cap, c->n_rows + 1, sizeof *c->row_speed);
-    c->row_t[c->n_rows] = s->t;
-    c->row_speed[c->n_rows++] = speed;
+    c->rows = grow(c->rows, &c->cap_rows, c->n_rows, sizeof *c->rows);
+    c->rows[c->n_rows++] = (struct row){s->t, speed};
     return BK_OK;
 }
 
@@ -58,7 +55,7 @@ static int on_transition(void *self, const bk_transition *t, bk_error *err)
 {
     (void)err;
     catalog_sink *c = self;
-    c->transitions = grow(c->transitions, &c->cap_transitions, c->n_transitions + 1, sizeof *t);
+    c->transitions = grow(c->transitions, &c->cap_transitions, c->n_transitions, sizeof *t);
     c->transitions[c->n_transitions++] = *t;
     return BK_OK;
 }
@@ -67,7 +64,7 @@ static int on_event(void *self, const bk_event *e, bk_error *err)
 {
     (void)err;
     catalog_sink *c = self;
-    c->events = grow(c->events, &c->cap_events, c->n_events + 1, sizeof *e);
+    c->events = grow(c->events, &c->cap_events, c->n_events, sizeof *e);
     c->events[c->n_events++] = *e;
     return BK_OK;
 }
@@ -77,8 +74,7 @@ static void sink_free(catalog_sink *c)
     free(c->transitions);
     free(c->events);
     free(c->x_last);
-    free(c->row_t);
-    free(c->row_speed);
+    free(c->rows);
 }
 
 static bk_config *load(const char *text_or_path, int is_path, const char *const *overrides, size_t n)
@@ -307,9 +303,9 @@ static void test_max_slip_rate_chain(void **state)
         for (size_t k = 0, row = 0; k < s.n_events; ++k) {
             const bk_event *e = &s.events[k];
             double sampled = 0.0;
-            for (; row < s.n_rows && s.row_t[row] <= e->t_end; ++row)
-                if (s.row_t[row] >= e->t_start)
-                    sampled = fmax(sampled, s.row_speed[row]);
+            for (; row < s.n_rows && s.rows[row].t <= e->t_end; ++row)
+                if (s.rows[row].t >= e->t_start)
+                    sampled = fmax(sampled, s.rows[row].speed);
             assert_true(e->max_slip_rate >= sampled * (1.0 - 1e-9));
             assert_close(e->max_slip_rate, sampled, 2e-3, 0.0);
         }
@@ -338,14 +334,14 @@ static void test_threshold_law(void **state)
     const double threshold = 3e-3;
     size_t k = 0;
     for (size_t row = 0; row < s.n_rows; ++row) {
-        double t = s.row_t[row];
+        double t = s.rows[row].t;
         while (k < s.n_events && t > s.events[k].t_end)
             ++k;
         int inside = k < s.n_events && t >= s.events[k].t_start;
         if (!inside)
-            assert_true(s.row_speed[row] <= threshold * (1.0 + 1e-9));
+            assert_true(s.rows[row].speed <= threshold * (1.0 + 1e-9));
         else
-            assert_true(s.row_speed[row] >= threshold * (1.0 - 1e-6));
+            assert_true(s.rows[row].speed >= threshold * (1.0 - 1e-6));
     }
     for (k = 0; k < s.n_events; ++k) {
         assert_true(s.events[k].max_slip_rate > threshold);

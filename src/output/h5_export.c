@@ -318,11 +318,6 @@ int bk_h5_export(const char *path, const char *datasets, long block, int transit
 
 /* ------------------------------------------------------------------ /events --- */
 
-/* The fields of bksim's catalog, in the order of the table and of the header. */
-static const char *const event_fields[] = {"t_start",  "t_end",         "first_block", "n_blocks",
-                                           "left",     "right",         "n_episodes",  "potency",
-                                           "magnitude", "max_slip_rate", "stress_drop", "complete"};
-
 static void events_header(FILE *out)
 {
     fputs("# t_start[s]\tt_end[s]\tfirst_block[1]\tn_blocks[1]\tleft[1]\tright[1]\t"
@@ -331,49 +326,16 @@ static void events_header(FILE *out)
           out);
 }
 
-static void print_event(const bk_event *e, FILE *out)
+static int print_event(const bk_event *e, unsigned long long row, void *user, bk_error *err)
 {
+    (void)err;
+    FILE *out = user;
+    if (row == 0)
+        events_header(out);
     fprintf(out, "%.17g\t%.17g\t%d\t%d\t%d\t%d\t%d\t%.17g\t%.17g\t%.17g\t%.17g\t%d\n", e->t_start,
             e->t_end, (int)e->first_block, (int)e->n_blocks, (int)e->left, (int)e->right,
             (int)e->n_episodes, e->potency, e->magnitude, e->max_slip_rate, e->stress_drop,
             (int)e->complete);
-}
-
-/* Opens /events: a 1-D compound table with every field of bksim's catalog. */
-static int open_events(hid_t file, const char *path, hid_t *dset, hsize_t *count, bk_error *err)
-{
-    *dset = H5I_INVALID_HID;
-    htri_t exists = H5Lexists(file, "events", H5P_DEFAULT);
-    if (exists < 0)
-        return H5_FAIL(err, "%s: cannot look for /events", path);
-    if (exists == 0)
-        return BK_FAIL(err, BK_ERR_INVALID,
-                       "%s: no /events table (the event catalog of a chain run with [output] "
-                       "events = true, the default; prescribed scenes have none)",
-                       path);
-    hid_t d = H5Dopen2(file, "events", H5P_DEFAULT);
-    if (d < 0)
-        return H5_FAIL(err, "%s: /events is not a readable dataset", path);
-    hid_t type = H5Dget_type(d), space = H5Dget_space(d);
-    hsize_t dims[1] = {0};
-    int rc = BK_OK;
-    if (type < 0 || space < 0)
-        rc = H5_DAMAGED(err, "%s: cannot read the type and shape of /events", path);
-    else if (H5Tget_class(type) != H5T_COMPOUND || H5Sget_simple_extent_ndims(space) != 1 ||
-             H5Sget_simple_extent_dims(space, dims, NULL) < 0)
-        rc = BK_FAIL(err, BK_ERR_INVALID, "%s: /events is not a 1-D compound table", path);
-    for (size_t k = 0; rc == BK_OK && k < sizeof event_fields / sizeof event_fields[0]; ++k)
-        if (H5Tget_member_index(type, event_fields[k]) < 0)
-            rc = BK_FAIL(err, BK_ERR_INVALID,
-                         "%s: /events has no field '%s' (not a catalog written by bksim)", path,
-                         event_fields[k]);
-    CLOSE_IDS(0, space, type);
-    if (rc != BK_OK) {
-        bk_h5_close_id(d);
-        return rc;
-    }
-    *dset = d;
-    *count = dims[0];
     return BK_OK;
 }
 
@@ -381,32 +343,15 @@ int bk_h5_export_events(const char *path, FILE *out, bk_error *err)
 {
     if (!out)
         return BK_FAIL(err, BK_ERR_INVALID, "bk_h5_export_events: no output stream");
-    hid_t file, dset = H5I_INVALID_HID, mem = H5I_INVALID_HID;
+    hid_t file;
     int rc = bk_h5_open_input(path, &file, err);
     if (rc != BK_OK)
         return rc;
     hsize_t count = 0;
-    rc = open_events(file, path, &dset, &count, err);
-    if (rc == BK_OK && (mem = bk_h5_event_type(0)) < 0)
-        rc = H5_FAIL(err, "%s: cannot build the event type", path);
-    /* One chunk of /events at a time (the writer appends EVENT_BUFFER rows per chunk). */
-    bk_event *buf = NULL;
-    if (rc == BK_OK && !(buf = malloc(EVENT_BUFFER * sizeof *buf)))
-        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
-    if (rc == BK_OK)
-        events_header(out);
-    for (hsize_t start = 0; rc == BK_OK && start < count; start += EVENT_BUFFER) {
-        size_t n = count - start < EVENT_BUFFER ? (size_t)(count - start) : EVENT_BUFFER;
-        if (bk_h5_read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
-            rc = H5_DAMAGED(err, "%s: damaged: /events rows %llu..%llu cannot be read", path,
-                            (unsigned long long)start, (unsigned long long)(start + n - 1));
-            break;
-        }
-        for (size_t k = 0; k < n; ++k)
-            print_event(&buf[k], out);
-    }
-    free(buf);
-    CLOSE_IDS(0, mem, dset, file);
+    rc = bk_h5_each_event(file, path, print_event, out, &count, err);
+    if (rc == BK_OK && count == 0)
+        events_header(out); /* an empty catalog: the header alone */
+    bk_h5_close_id(file);
     if (rc == BK_OK && (fflush(out) != 0 || ferror(out)))
         rc = BK_FAIL(err, BK_ERR_IO, "%s: writing the export failed", path);
     return rc;

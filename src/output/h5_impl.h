@@ -155,6 +155,16 @@ int bk_h5_open_transitions(hid_t file, const char *path, hid_t *dset, hid_t *mem
                            hsize_t *count, bk_error *err);
 /* Every /transitions record in order (read TRANSITION_BUFFER at a time) through visit, which
  * returns BK_OK to go on; *count gets the table's length. */
+/* Opens /events, a 1-D compound table with every field of bksim's catalog, and its memory
+ * type; count = rows.  BK_ERR_INVALID when there is none or it is another program's. */
+int bk_h5_open_events(hid_t file, const char *path, hid_t *dset, hid_t *mem, hsize_t *count,
+                      bk_error *err);
+/* Every /events record in order (EVENT_BUFFER at a time) through visit, which returns BK_OK to
+ * go on; *count gets the table's length. */
+typedef int (*bk_h5_event_visit)(const bk_event *event, unsigned long long row, void *user,
+                                 bk_error *err);
+int bk_h5_each_event(hid_t file, const char *path, bk_h5_event_visit visit, void *user,
+                     hsize_t *count, bk_error *err);
 typedef int (*bk_h5_transition_visit)(const bk_transition *t, unsigned long long row, void *user,
                                       bk_error *err);
 int bk_h5_each_transition(hid_t file, const char *path, bk_h5_transition_visit visit, void *user,

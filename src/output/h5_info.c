@@ -235,13 +235,12 @@ int bk_h5_info(const char *path, FILE *out, bk_error *err)
         fprintf(out, "transitions  %ld\n", total);
     else
         fprintf(out, "transitions  not recorded\n");
-    hid_t events = H5Lexists(file, "events", H5P_DEFAULT) > 0 ? H5Dopen2(file, "events", H5P_DEFAULT)
-                                                               : H5I_INVALID_HID;
-    hid_t event_space = events < 0 ? H5I_INVALID_HID : H5Dget_space(events);
-    hssize_t n_events = event_space < 0 ? -1 : H5Sget_simple_extent_npoints(event_space);
-    CLOSE_IDS(0, event_space, events);
-    if (n_events >= 0)
-        fprintf(out, "events       %lld (the catalog: bksim stats %s)\n", (long long)n_events, path);
+    hid_t events, event_type;
+    hsize_t n_events = 0;
+    int have_events = bk_h5_open_events(file, path, &events, &event_type, &n_events, NULL) == BK_OK;
+    CLOSE_IDS(0, event_type, events);
+    if (have_events)
+        fprintf(out, "events       %llu (the catalog: bksim stats %s)\n", (unsigned long long)n_events, path);
     else
         fprintf(out, "events       not recorded\n");
     print_stats(file, out);

@@ -374,38 +374,99 @@ int bk_h5_load_stored_config(hid_t file, const char *path, bk_config **config, b
     return rc;
 }
 
+/* The fields of bksim's catalog, in the order of the table. */
+static const char *const event_fields[] = {"t_start",  "t_end",         "first_block", "n_blocks",
+                                           "left",     "right",         "n_episodes",  "potency",
+                                           "magnitude", "max_slip_rate", "stress_drop", "complete"};
+
+int bk_h5_open_events(hid_t file, const char *path, hid_t *dset, hid_t *mem, hsize_t *count,
+                      bk_error *err)
+{
+    *dset = *mem = H5I_INVALID_HID;
+    htri_t exists = H5Lexists(file, "events", H5P_DEFAULT);
+    if (exists < 0)
+        return H5_FAIL(err, "%s: cannot look for /events", path);
+    if (exists == 0)
+        return BK_FAIL(err, BK_ERR_INVALID,
+                       "%s: no /events table (the event catalog of a chain run with [output] "
+                       "events = true, the default; prescribed scenes have none)",
+                       path);
+    hid_t d = H5Dopen2(file, "events", H5P_DEFAULT);
+    if (d < 0)
+        return H5_FAIL(err, "%s: /events is not a readable dataset", path);
+    hid_t type = H5Dget_type(d), space = H5Dget_space(d);
+    hsize_t dims[1] = {0};
+    int rc = BK_OK;
+    if (type < 0 || space < 0)
+        rc = H5_DAMAGED(err, "%s: cannot read the type and shape of /events", path);
+    else if (H5Tget_class(type) != H5T_COMPOUND || H5Sget_simple_extent_ndims(space) != 1 ||
+             H5Sget_simple_extent_dims(space, dims, NULL) < 0)
+        rc = BK_FAIL(err, BK_ERR_INVALID, "%s: /events is not a 1-D compound table", path);
+    for (size_t k = 0; rc == BK_OK && k < sizeof event_fields / sizeof event_fields[0]; ++k)
+        if (H5Tget_member_index(type, event_fields[k]) < 0)
+            rc = BK_FAIL(err, BK_ERR_INVALID,
+                         "%s: /events has no field '%s' (not a catalog written by bksim)", path,
+                         event_fields[k]);
+    CLOSE_IDS(0, space, type);
+    if (rc == BK_OK && (*mem = bk_h5_event_type(0)) < 0)
+        rc = H5_FAIL(err, "%s: cannot build the event type", path);
+    if (rc != BK_OK) {
+        bk_h5_close_id(d);
+        return rc;
+    }
+    *dset = d;
+    *count = dims[0];
+    return BK_OK;
+}
+
+int bk_h5_each_event(hid_t file, const char *path, bk_h5_event_visit visit, void *user,
+                     hsize_t *count, bk_error *err)
+{
+    hid_t dset, mem;
+    int rc = bk_h5_open_events(file, path, &dset, &mem, count, err);
+    if (rc != BK_OK)
+        return rc;
+    bk_event *buf = malloc(EVENT_BUFFER * sizeof *buf);
+    if (!buf)
+        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    for (hsize_t start = 0; rc == BK_OK && start < *count; start += EVENT_BUFFER) {
+        size_t n = *count - start < EVENT_BUFFER ? (size_t)(*count - start) : EVENT_BUFFER;
+        if (bk_h5_read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
+            rc = H5_DAMAGED(err, "%s: damaged: /events rows %llu..%llu cannot be read", path,
+                            (unsigned long long)start, (unsigned long long)(start + n - 1));
+            break;
+        }
+        for (size_t k = 0; rc == BK_OK && k < n; ++k)
+            rc = visit(&buf[k], (unsigned long long)(start + k), user, err);
+    }
+    free(buf);
+    CLOSE_IDS(0, mem, dset);
+    return rc;
+}
+
 int bk_h5_read_events(const char *path, bk_event **rows, size_t *count, bk_error *err)
 {
     if (!rows || !count)
         return BK_FAIL(err, BK_ERR_INVALID, "bk_h5_read_events: missing argument");
     *rows = NULL;
     *count = 0;
-    hid_t file;
+    hid_t file, dset = H5I_INVALID_HID, mem = H5I_INVALID_HID;
+    hsize_t n = 0;
     int rc = bk_h5_open_input(path, &file, err);
     if (rc != BK_OK)
         return rc;
-    hid_t dset = H5Lexists(file, "events", H5P_DEFAULT) > 0 ? H5Dopen2(file, "events", H5P_DEFAULT)
-                                                            : H5I_INVALID_HID;
-    hid_t mem = dset < 0 ? H5I_INVALID_HID : bk_h5_event_type(0);
-    hid_t space = dset < 0 ? H5I_INVALID_HID : H5Dget_space(dset);
-    hssize_t n = space < 0 ? -1 : H5Sget_simple_extent_npoints(space);
-    if (dset < 0 || mem < 0 || n < 0) {
-        rc = dset < 0 ? BK_FAIL(err, BK_ERR_INVALID, "%s: no /events table", path)
-                      : H5_FAIL(err, "%s: cannot read /events", path);
+    rc = bk_h5_open_events(file, path, &dset, &mem, &n, err);
+    bk_event *values = NULL;
+    if (rc == BK_OK && !(values = n > SIZE_MAX / sizeof *values ? NULL : calloc(n ? (size_t)n : 1, sizeof *values)))
+        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory reading /events", path);
+    else if (rc == BK_OK && n > 0 && H5Dread(dset, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, values) < 0)
+        rc = H5_FAIL(err, "%s: cannot read /events", path);
+    if (rc == BK_OK) {
+        *rows = values;
+        *count = (size_t)n;
     } else {
-        bk_event *values = (size_t)n > SIZE_MAX / sizeof *values ? NULL
-                                                                  : calloc(n ? (size_t)n : 1, sizeof *values);
-        if (!values)
-            rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory reading /events", path);
-        else if (n > 0 && H5Dread(dset, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, values) < 0)
-            rc = H5_FAIL(err, "%s: cannot read /events (a table of bksim's event fields)", path);
-        if (rc == BK_OK) {
-            *rows = values;
-            *count = (size_t)n;
-        } else {
-            free(values);
-        }
+        free(values);
     }
-    CLOSE_IDS(rc, space, mem, dset, file);
+    CLOSE_IDS(rc, mem, dset, file);
     return rc;
 }

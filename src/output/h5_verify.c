@@ -165,12 +165,17 @@ static int scan_transitions(hid_t file, const verify_ctx *v, bk_error *err)
     return rc;
 }
 
+typedef struct event_check {
+    const verify_ctx *v;
+    double prev; /* s, the end of the row before */
+} event_check;
+
 /* One /events row as a catalog bksim wrote holds it. */
-static int check_event(const verify_ctx *v, const bk_event *e, unsigned long long row, double *prev,
-                       bk_error *err)
+static int check_event(const bk_event *e, unsigned long long row, void *user, bk_error *err)
 {
-    const char *path = v->path;
-    long long n = v->n_blocks;
+    event_check *c = user;
+    const char *path = c->v->path;
+    long long n = c->v->n_blocks;
     int blocks_ok = e->first_block >= 0 && e->first_block < n && e->left >= 0 && e->left < n &&
                     e->right >= 0 && e->right < n && e->n_blocks >= 1 && e->n_blocks <= n &&
                     e->n_episodes >= e->n_blocks;
@@ -185,39 +190,22 @@ static int check_event(const verify_ctx *v, const bk_event *e, unsigned long lon
                        "right %d, n_blocks %d, n_episodes %d, complete %d (blocks 0..%lld)", path, row,
                        (int)e->first_block, (int)e->left, (int)e->right, (int)e->n_blocks,
                        (int)e->n_episodes, (int)e->complete, n - 1);
-    if (e->t_start < *prev)
+    if (e->t_start < c->prev)
         return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /events is not in time order at row %llu "
-                       "(t_start = %.17g s after an event that ended at %.17g s)", path, row, e->t_start, *prev);
-    *prev = e->t_end;
+                       "(t_start = %.17g s after an event that ended at %.17g s)", path, row, e->t_start, c->prev);
+    c->prev = e->t_end;
     return BK_OK;
 }
 
-/* Every /events row read (the chunk checksums) and checked, a buffer at a time. */
+/* Every /events row read (the chunk checksums) and checked; a table that does not open is
+ * damage too (the file says it wrote one). */
 static int scan_events(hid_t file, const verify_ctx *v, bk_error *err)
 {
-    hid_t dset = H5Dopen2(file, "events", H5P_DEFAULT);
-    hid_t mem = dset < 0 ? H5I_INVALID_HID : bk_h5_event_type(0);
-    hid_t space = dset < 0 ? H5I_INVALID_HID : H5Dget_space(dset);
-    hssize_t n = space < 0 ? -1 : H5Sget_simple_extent_npoints(space);
-    bk_event *buf = malloc(EVENT_BUFFER * sizeof *buf);
-    int rc = BK_OK;
-    if (!buf)
-        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", v->path);
-    else if (mem < 0 || n < 0)
-        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /events cannot be read", v->path);
-    double prev = -INFINITY;
-    for (hsize_t start = 0; rc == BK_OK && start < (hsize_t)n; start += EVENT_BUFFER) {
-        hsize_t count = (hsize_t)n - start < EVENT_BUFFER ? (hsize_t)n - start : EVENT_BUFFER;
-        if (bk_h5_read_block(dset, 1, start, count, 0, 1, mem, buf) < 0) {
-            rc = H5_DAMAGED(err, "%s: damaged: /events rows %llu..%llu cannot be read", v->path,
-                            (unsigned long long)start, (unsigned long long)(start + count - 1));
-            break;
-        }
-        for (hsize_t k = 0; rc == BK_OK && k < count; ++k)
-            rc = check_event(v, &buf[k], (unsigned long long)(start + k), &prev, err);
-    }
-    free(buf);
-    CLOSE_IDS(rc == BK_OK ? 0 : -1, space, mem, dset);
+    event_check check = {v, -INFINITY};
+    hsize_t count = 0;
+    int rc = bk_h5_each_event(file, v->path, check_event, &check, &count, err);
+    if (rc == BK_ERR_HDF5 || rc == BK_ERR_INVALID)
+        return mark_damaged(err, v->path, "/events cannot be read");
     return rc;
 }
 
