@@ -128,7 +128,9 @@ int bk_run_prescribed(const bk_config *config, const bk_sink *sink, bk_run_stats
             law->state_advance(b->friction_params, rate, dt, start_state);
         slip_start += rate * dt;
         segment_start = segment_end;
-        if (rc == BK_OK && progress && progress(progress_user, segment_start, t_end) != 0)
+        bk_progress report = {
+            .t = segment_start, .t_end = t_end, .transitions = stats ? stats->transitions : 0, .events = -1};
+        if (rc == BK_OK && progress && progress(progress_user, &report) != 0)
             rc = BK_FAIL(err, BK_ERR_INTERRUPTED, "run interrupted at t = %.17g s", segment_start);
     }
     if (stats) {

@@ -44,8 +44,18 @@ double bk_run_wall_seconds(void)
 
 int bk_run_report_progress(run_ctx *ctx, double t)
 {
-    if (ctx->progress && ctx->progress(ctx->progress_user, t, ctx->t_end) != 0)
-        return BK_FAIL(ctx->err, BK_ERR_INTERRUPTED, "run interrupted at t = %.17g s", t);
+    if (ctx->progress) {
+        bk_progress report = {
+            .t = ctx->t_progress = fmax(ctx->t_progress, t),
+            .t_end = ctx->t_end,
+            .t_resumed = ctx->t_resumed,
+            .transitions = ctx->stats->transitions,
+            .events = ctx->catalog ? ctx->events : -1,
+            .events_resumed = ctx->events_resumed,
+        };
+        if (ctx->progress(ctx->progress_user, &report) != 0)
+            return BK_FAIL(ctx->err, BK_ERR_INTERRUPTED, "run interrupted at t = %.17g s", t);
+    }
     double limit = ctx->config->wall_time_limit;
     if (limit > 0.0 && bk_run_wall_seconds() - ctx->wall_start > limit)
         return BK_FAIL(ctx->err, BK_ERR_INTERRUPTED,
@@ -355,6 +365,7 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
         goto done;
 
     if (from) {
+        ctx.t_resumed = ctx.t_progress = from->t;
         if ((rc = bk_run_resume(&ctx, from)) != BK_OK || (rc = bk_run_partition_all(&ctx, from->t)) != BK_OK)
             goto done;
     } else {

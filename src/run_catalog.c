@@ -69,7 +69,7 @@ int bk_run_catalog_init(run_ctx *ctx, const bk_checkpoint *from)
             return BK_FAIL(ctx->err, BK_ERR_INVALID,
                            "the checkpoint's event catalog does not hold together (a slipping block "
                            "outside the open event, or an open event without blocks)");
-        ctx->events = from->catalog->events;
+        ctx->events = ctx->events_resumed = from->catalog->events;
         for (size_t i = 0; i < n && scene->above; ++i)
             scene->above[i] = !scene->can_stick[i] && from->catalog->slipping[i];
         return BK_OK;

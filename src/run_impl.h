@@ -113,6 +113,9 @@ typedef struct run_ctx {
     /* The event catalog (run_catalog.c); NULL when the run keeps none. */
     bk_catalog *catalog;
     long events;          /* events completed */
+    long events_resumed;  /* events completed before this call began */
+    double t_resumed;     /* s, where this call began */
+    double t_progress;    /* s, the furthest time reported to the progress callback */
     double t_catalog;     /* s, where the builder's force callback evaluates */
     double *rate_v, *rate_a; /* per block: v and d|v|/dt at its island's last step end */
     bk_catalog_state catalog_state; /* what a checkpoint saves (arrays only with checkpoints) */

@@ -555,6 +555,40 @@ static int run_and_signal(const char *out, const char *signal_name, char **text)
 
 /* SIGTERM and SIGINT stop the run at the next step: the file stays "<out>.part", intact and
  * marked incomplete (complete = 0, t_reached); `bksim info` says so with exit status 3. */
+/* Progress of a long run on a terminal: simulated time, events so far and per second, and
+ * an ETA, on stderr; silent with --quiet and when stderr is not a terminal (script(1) gives
+ * the run a terminal). The run takes about 2 s: progress shows after the first second. */
+static void test_progress_on_terminal(void **state)
+{
+    (void)state;
+    char cmd[2048];
+    char *text = NULL;
+    const char *run = "./bksim run configs/chains/carlson_langer_100.ini --force --set run.t_end=1600 -o";
+    snprintf(cmd, sizeof cmd, "script -qec \"%s %s/tty.h5\" /dev/null", run, tmpdir);
+    assert_int_equal(run_command(cmd, &text), 0);
+    const char *line = strstr(text, "bksim: t = ");
+    if (!line)
+        print_error("%s\n", text);
+    assert_non_null(line);
+    assert_non_null(strstr(line, " of 1600 s ("));
+    assert_non_null(strstr(line, " events ("));
+    assert_non_null(strstr(line, " per s), "));
+    assert_non_null(strstr(line, " elapsed, ETA "));
+    assert_non_null(strstr(text, "tty.h5: ")); /* the summary follows on its own line */
+    free(text);
+
+    snprintf(cmd, sizeof cmd, "script -qec \"%s %s/quiet.h5 --quiet\" /dev/null", run, tmpdir);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_string_equal(text, "");
+    free(text);
+
+    snprintf(cmd, sizeof cmd, "%s %s/pipe.h5 2>%s/pipe.err >/dev/null && cat %s/pipe.err", run, tmpdir, tmpdir,
+             tmpdir);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_string_equal(text, "");
+    free(text);
+}
+
 static void test_interrupted_run_is_marked(void **state)
 {
     (void)state;
@@ -932,6 +966,7 @@ int main(void)
         cmocka_unit_test(test_bad_inputs),
         cmocka_unit_test(test_every_key_rejects_bad_values),
         cmocka_unit_test(test_commands),
+        cmocka_unit_test(test_progress_on_terminal),
         cmocka_unit_test(test_interrupted_run_is_marked),
         cmocka_unit_test(test_killed_run_leaves_partial),
         cmocka_unit_test(test_damaged_files),

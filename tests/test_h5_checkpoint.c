@@ -16,6 +16,24 @@
 #include "same_output.h"
 #include "stopping_sink.h"
 
+/* A resumed run tells its progress callback where it resumed, and counts on from there. */
+typedef struct resume_check {
+    const bk_checkpoint *from;
+    long calls;
+} resume_check;
+
+static int check_resumed(void *user, const bk_progress *p)
+{
+    resume_check *rc = user;
+    rc->calls++;
+    assert_true(p->t_resumed == rc->from->t && p->t >= p->t_resumed);
+    long before = rc->from->catalog ? rc->from->catalog->events : 0;
+    assert_int_equal(p->events_resumed, before);
+    assert_true(p->events < 0 || p->events >= before);
+    assert_true(p->transitions >= rc->from->stats.transitions);
+    return 0;
+}
+
 /* Restart path.part and run it to the end; returns the checkpoint's t. */
 static double restart_to_end(const char *path)
 {
@@ -28,9 +46,11 @@ static double restart_to_end(const char *path)
         fail_msg("resume: %s", err.message);
     bk_sink sink = bk_h5_writer_sink(w);
     bk_run_stats stats;
-    rc = bk_run_from(config, &cp, &sink, &stats, NULL, NULL, &err);
+    resume_check check = {&cp, 0};
+    rc = bk_run_from(config, &cp, &sink, &stats, check_resumed, &check, &err);
     if (rc != BK_OK)
         fail_msg("run: %s", err.message);
+    assert_true(check.calls > 0);
     double t = cp.t;
     bk_checkpoint_free(&cp);
     assert_int_equal(bk_h5_writer_finish(w, &stats, &err), BK_OK);

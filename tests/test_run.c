@@ -319,11 +319,10 @@ static void test_chattering_guard(void **state)
 }
 
 /* A progress callback can stop a run. */
-static int stop_at_one_second(void *user, double t, double t_end)
+static int stop_at_one_second(void *user, const bk_progress *progress)
 {
     (void)user;
-    (void)t_end;
-    return t > 1.0;
+    return progress->t > 1.0;
 }
 
 static void test_interrupt(void **state)

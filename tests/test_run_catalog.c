@@ -24,6 +24,7 @@ typedef struct catalog_sink {
         double t, speed; /* s; the largest |v| of the row, m/s */
     } *rows;
     size_t n_rows, cap_rows;
+    int sink_has_events;      /* the run keeps a catalog */
 } catalog_sink;
 
 /* Room for one more item (a failed allocation fails the test). */
@@ -209,6 +210,46 @@ static void test_overlap_at_opposite_ends(void **state)
     expect_rebuilt(c, &s);
     sink_free(&s);
     bk_config_free(c);
+}
+
+/* What a progress callback is told matches what the sink has received at that moment. */
+typedef struct progress_check {
+    const catalog_sink *sink;
+    long calls;
+    double t_last;
+} progress_check;
+
+static int check_progress(void *user, const bk_progress *p)
+{
+    progress_check *pc = user;
+    pc->calls++;
+    assert_true(p->t >= pc->t_last && p->t <= p->t_end);
+    pc->t_last = p->t;
+    assert_true(p->t_resumed == 0.0 && p->events_resumed == 0);
+    /* Transitions of the instant under way are counted before the sink has them. */
+    long pending = p->transitions - (long)pc->sink->n_transitions;
+    assert_true(pending >= 0 && pending <= 2 * 40);
+    assert_int_equal(p->events, pc->sink->sink_has_events ? (long)pc->sink->n_events : -1);
+    return 0;
+}
+
+static void test_progress_counts(void **state)
+{
+    (void)state;
+    for (int with_events = 1; with_events >= 0; --with_events) {
+        const char *overrides[] = {with_events ? "output.events=true" : "output.events=false", "run.t_end=3"};
+        bk_config *c = load(chain_text, 0, overrides, 2);
+        catalog_sink s = {.sink_has_events = with_events};
+        progress_check pc = {.sink = &s};
+        bk_sink sink = {.self = &s, .sample = on_sample, .transition = on_transition, .event = on_event};
+        bk_error err = {0};
+        if (bk_run(c, &sink, NULL, check_progress, &pc, &err) != BK_OK)
+            fail_msg("%s", err.message);
+        assert_true(pc.calls > 10);
+        assert_true(!with_events || s.n_events >= 2);
+        sink_free(&s);
+        bk_config_free(c);
+    }
 }
 
 /* Case A's first slip runs from 0.5886 s to 0.6204 s: a run ending at 0.6 s keeps it, marked
@@ -428,6 +469,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_chain_1000_matches_rebuild),
         cmocka_unit_test(test_overlap_at_opposite_ends),
+        cmocka_unit_test(test_progress_counts),
         cmocka_unit_test(test_event_running_at_end),
         cmocka_unit_test(test_uniform_ring_closed_form),
         cmocka_unit_test(test_max_slip_rate_chain),

@@ -278,7 +278,21 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static int show_progress(void *user, double t, double t_end)
+/* A duration as a person reads it: "42 s", "12 min 05 s", "3 h 20 min", "2 d 04 h". */
+static void format_duration(char *out, size_t size, double seconds)
+{
+    long s = seconds < 0.0 ? 0 : seconds > 9.9e8 ? 990000000L : (long)(seconds + 0.5);
+    if (s < 60)
+        snprintf(out, size, "%ld s", s);
+    else if (s < 3600)
+        snprintf(out, size, "%ld min %02ld s", s / 60, s % 60);
+    else if (s < 86400)
+        snprintf(out, size, "%ld h %02ld min", s / 3600, s % 3600 / 60);
+    else
+        snprintf(out, size, "%ld d %02ld h", s / 86400, s % 86400 / 3600);
+}
+
+static int show_progress(void *user, const bk_progress *r)
 {
     progress_state *p = user;
     if (stop_requested)
@@ -288,10 +302,26 @@ static int show_progress(void *user, double t, double t_end)
     double now = now_seconds();
     if (now - p->start < 1.0 || now - p->last_print < 0.1)
         return 0;
+    double elapsed = now - p->start;
     p->last_print = now;
     p->printed = 1;
-    fprintf(stderr, "\rbksim: t = %.6g s of %g s (%3.0f%%), %.0f s elapsed ", t, t_end,
-            100.0 * t / t_end, now - p->start);
+    char produced[96], spent[32], eta[40] = "";
+    if (r->events >= 0)
+        snprintf(produced, sizeof produced, "%ld events (%.3g per s)", r->events,
+                 (double)(r->events - r->events_resumed) / elapsed);
+    else
+        snprintf(produced, sizeof produced, "%ld transitions", r->transitions);
+    format_duration(spent, sizeof spent, elapsed);
+    /* Simulated time per wall-clock second since this run began: a stick-slip run's pace
+     * varies from event to event, and the whole run's average is the steadier forecast. */
+    if (r->t > r->t_resumed) {
+        char left[32];
+        format_duration(left, sizeof left, elapsed * (r->t_end - r->t) / (r->t - r->t_resumed));
+        snprintf(eta, sizeof eta, ", ETA %s", left);
+    }
+    /* \033[K clears what a longer previous line left. */
+    fprintf(stderr, "\rbksim: t = %.6g s of %g s (%.0f%%), %s, %s elapsed%s\033[K", r->t, r->t_end,
+            100.0 * r->t / r->t_end, produced, spent, eta);
     fflush(stderr);
     return 0;
 }
