@@ -31,12 +31,21 @@ int bk_stats_report_text(const bk_stats_report *r, FILE *out, bk_error *err)
                      "finite t_start and magnitude%s\n",
                 r->n_incomplete, r->n_nonfinite,
                 r->n_nonfinite && r->has_potency ? " (zero potency: magnitude -inf)" : "");
+    if (isfinite(o->t_from) || isfinite(o->t_to)) {
+        char from[48] = "", to[48] = "";
+        if (isfinite(o->t_from))
+            snprintf(from, sizeof from, " t >= %.9g s", o->t_from);
+        if (isfinite(o->t_to))
+            snprintf(to, sizeof to, "%s t < %.9g s", *from ? " and" : "", o->t_to);
+        fprintf(out, "  time window: events starting at%s%s; %zu outside it left out\n", from, to,
+                r->n_outside);
+    }
     fprintf(out, "  events: %zu", r->n_events);
     if (r->n_events) {
         fprintf(out, ", starts from %.9g s to %.9g s\n", r->t_first, r->t_last);
-        fprintf(out, "  duration: %.9g s (%s); rate %.6g events/s\n", r->duration,
+        fprintf(out, "  duration: %.9g s (%s%s); rate %.6g events/s\n", r->duration,
                 r->duration_from_run ? "the run's t_reached" : "the catalog's span",
-                r->rate);
+                isfinite(o->t_from) || isfinite(o->t_to) ? " within the window" : "", r->rate);
         fprintf(out, "  magnitudes: %.4f to %.4f\n", r->m_min, r->m_max);
     } else {
         fprintf(out, "\n");
@@ -86,7 +95,7 @@ int bk_stats_report_text(const bk_stats_report *r, FILE *out, bk_error *err)
     else
         fprintf(out, "sizes: not available: %s\n", r->sizes_note);
     if (r->have_ks)
-        fprintf(out, "stationarity: KS test of the magnitudes >= Mc before and after t = %.6g s "
+        fprintf(out, "stationarity: KS test of the binned magnitudes >= Mc before and after t = %.6g s "
                      "(%zu and %zu events): D = %.4f, p = %.4g%s\n",
                 r->ks_t_split, r->ks.n1, r->ks.n2, r->ks.d, r->ks.p,
                 r->ks.p < 0.05 ? " (differ at 5%)" : "");
@@ -155,6 +164,9 @@ int bk_stats_report_json(const bk_stats_report *r, FILE *out, bk_error *err)
     json_count(out, "n_rows", r->n_rows);
     json_count(out, "n_incomplete", r->n_incomplete);
     json_count(out, "n_nonfinite", r->n_nonfinite);
+    json_number(out, "t_from", r->options.t_from, 0);
+    json_number(out, "t_to", r->options.t_to, 0);
+    json_count(out, "n_outside_window", r->n_outside);
     json_count(out, "n_events", r->n_events);
     json_number(out, "duration", r->n_events ? r->duration : absent, 0);
     fprintf(out, "\"duration_source\": \"%s\", ", r->duration_from_run ? "run" : "catalog");

@@ -519,8 +519,21 @@ static void test_commands(void **state)
     assert_non_null(strstr(text, "\"n_events\": 40"));
     assert_non_null(strstr(text, "\"b_value\""));
     free(text);
+    /* t_start 0..39: --from 10 --to=30 keeps 20 of them. */
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --mc 2.0 --json --from 10 --to=30", catalog);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_non_null(strstr(text, "\"n_outside_window\": 20, \"n_events\": 20"));
+    free(text);
     snprintf(cmd, sizeof cmd, "./bksim stats %s --bin -1", catalog);
     assert_int_equal(run_command(cmd, NULL), 2);
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --from 1e3x", catalog);
+    assert_int_equal(run_command(cmd, &text), 2);
+    assert_non_null(strstr(text, "--from needs a time in s, got '1e3x'"));
+    free(text);
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --from 30 --to 10", catalog);
+    assert_int_equal(run_command(cmd, &text), 2);
+    assert_non_null(strstr(text, "time window [30, 10) s"));
+    free(text);
     assert_int_equal(run_command("./bksim stats", NULL), 2);
 
     const char *helps[] = {"run", "check", "info", "export", "keys", "stats"};

@@ -674,17 +674,20 @@ static void test_report_bksim_catalog(void **state)
     assert_true(rep->have_sizes);
     assert_int_equal(rep->sizes.n_events, n + 1);
     assert_int_equal(rep->sizes.max_size, 1000);
-    /* The two-halves test compares the magnitudes above Mc before and after t_reached / 2. */
+    /* The two-halves test compares the binned magnitudes above Mc before and after
+     * t_reached / 2. */
     assert_true(rep->have_ks);
     assert_int_equal(rep->ks.n1 + rep->ks.n2, b.n);
     double *half1 = malloc(n * sizeof *half1), *half2 = malloc(n * sizeof *half2);
     size_t n1 = 0, n2 = 0;
     for (size_t i = 0; i < n; ++i)
         if (m[i] >= mc - 0.05) {
+            long k;
+            assert_int_equal(bk_mag_bin(r[i].magnitude, 0.1, &k, &err), BK_OK);
             if (r[i].t_start < 0.5 * t_reached)
-                half1[n1++] = r[i].magnitude;
+                half1[n1++] = 0.1 * (double)k;
             else
-                half2[n2++] = r[i].magnitude;
+                half2[n2++] = 0.1 * (double)k;
         }
     bk_ks_result ks;
     assert_int_equal(bk_ks_two_sample(half1, n1, half2, n2, &ks, &err), BK_OK);
@@ -735,6 +738,44 @@ static void test_report_bksim_catalog(void **state)
     assert_true(path_exists(file));
 
     bk_stats_report_free(rep);
+
+    /* A time window: only the events starting in [t_reached / 4, 3 t_reached / 4) count,
+     * and the span, the rate and the halves are the window's. */
+    opt.t_from = 0.25 * t_reached;
+    opt.t_to = 0.75 * t_reached;
+    assert_int_equal(bk_stats_report_read(path, &opt, &rep, &err), BK_OK);
+    size_t inside = 0;
+    for (size_t i = 0; i < n; ++i)
+        inside += r[i].t_start >= opt.t_from && r[i].t_start < opt.t_to;
+    assert_true(inside > n / 3 && inside < 2 * n / 3);
+    assert_int_equal(rep->n_events, inside);
+    assert_int_equal(rep->n_outside, n - inside); /* the -inf one counts as non-finite */
+    assert_int_equal(rep->sizes.n_events, inside);
+    assert_close(rep->duration, 0.5 * t_reached, 1e-15, 0.0);
+    assert_close(rep->rate, (double)inside / (0.5 * t_reached), 1e-15, 0.0);
+    assert_close(rep->ks_t_split, 0.5 * t_reached, 1e-15, 0.0);
+    assert_true(rep->have_b && rep->n_above_mc < b.n);
+    f = tmpfile();
+    assert_int_equal(bk_stats_report_json(rep, f, &err), BK_OK);
+    json = read_text(f);
+    fclose(f);
+    assert_close(json_value(json, "t_from"), opt.t_from, 0.0, 0.0);
+    assert_close(json_value(json, "n_outside_window"), (double)(n - inside), 0.0, 0.0);
+    free(json);
+    f = tmpfile();
+    assert_int_equal(bk_stats_report_text(rep, f, &err), BK_OK);
+    text = read_text(f);
+    fclose(f);
+    assert_non_null(strstr(text, "time window: events starting at t >= "));
+    free(text);
+    bk_stats_report_free(rep);
+    /* An empty or reversed window is refused, naming the window. */
+    opt.t_to = opt.t_from;
+    assert_int_equal(bk_stats_report_read(path, &opt, &rep, &err), BK_ERR_INVALID);
+    assert_null(rep);
+    assert_non_null(strstr(err.message, "time window"));
+    opt.t_from = -INFINITY;
+    opt.t_to = INFINITY;
     /* A given Mc. */
     opt.mc_auto = 0;
     opt.mc = 2.0;

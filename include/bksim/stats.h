@@ -186,6 +186,9 @@ typedef struct bk_stats_options {
     int mc_auto;           /* 1: maximum curvature plus mc_correction; 0: mc below */
     double mc;             /* a multiple of dm */
     double mc_correction;  /* BK_MAXC_CORRECTION */
+    /* s: only events starting in [t_from, t_to) count (a spin-up left out); default the
+     * whole catalog (-inf, +inf) */
+    double t_from, t_to;
 } bk_stats_options;
 
 void bk_stats_options_default(bk_stats_options *opt);
@@ -203,11 +206,15 @@ typedef struct bk_stats_report {
     size_t n_rows;         /* rows of /events */
     size_t n_incomplete;   /* complete = 0: still running at the end, left out */
     size_t n_nonfinite;    /* complete rows without a finite t_start and magnitude */
+    size_t n_outside;      /* complete rows starting outside [t_from, t_to) */
     size_t n_events;       /* the rest: the events every magnitude statistic uses */
     /* the analysed events, in file order */
     double *t_start, *magnitude, *potency;  /* potency NULL without the field */
     double t_first, t_last;
-    double duration;       /* s: the run's t_reached, else t_last - t_first */
+    double span_start;     /* s: where the observed span begins (0 for a run, else t_first),
+                            * t_from when that is later */
+    double duration;       /* s: the observed span, the run's t_reached (else t_last - t_first)
+                            * clipped to [t_from, t_to) */
     int duration_from_run; /* 1: the root attribute t_reached of a bksim output */
     double rate;           /* n_events / duration, 1/s (0 when the duration is 0) */
     double m_min, m_max;

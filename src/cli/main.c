@@ -4,6 +4,7 @@
  * config, 3 (info) an intact file of a run that did not finish. */
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -32,7 +33,7 @@ static const char *const usage_text =
     "                       print columns for gnuplot and shell tools\n"
     "  export OUT.h5 --events\n"
     "                       print the event catalog /events as TSV\n"
-    "  stats FILE [--mc auto|VALUE] [--bin DM] [--json] [--tsv DIR]\n"
+    "  stats FILE [--mc auto|VALUE] [--bin DM] [--from T] [--to T] [--json] [--tsv DIR]\n"
     "                       earthquake statistics of the catalog /events in FILE\n"
     "  keys                 print the config key reference (Markdown)\n"
     "  --version            print the version\n"
@@ -83,7 +84,8 @@ static const char *const export_help =
     "                    left > right when the extent wraps past block 0\n";
 
 static const char *const stats_help =
-    "usage: bksim stats FILE [--mc auto|VALUE] [--bin DM] [--json] [--tsv DIR]\n"
+    "usage: bksim stats FILE [--mc auto|VALUE] [--bin DM] [--from T] [--to T] [--json]\n"
+    "                        [--tsv DIR]\n"
     "\n"
     "Statistics of the earthquake catalog /events in the HDF5 file FILE (a table with at\n"
     "least t_start and magnitude): magnitude-frequency distribution, completeness magnitude\n"
@@ -93,6 +95,8 @@ static const char *const stats_help =
     "  --mc auto|VALUE   completeness magnitude: maximum curvature + 0.2 (auto, the\n"
     "                    default) or VALUE, a multiple of the bin width\n"
     "  --bin DM          magnitude bin width, 0 < DM <= 10 (default 0.1)\n"
+    "  --from T, --to T  only events starting at t >= T, t < T (s): leave a spin-up out;\n"
+    "                    rates, recurrence and the KS test use the window's span\n"
     "  --json            print one JSON object instead of the text report\n"
     "  --tsv DIR         also write tables for gnuplot to DIR (created if missing): mfd.tsv,\n"
     "                    gr_fit.tsv, sizes.tsv, sizes_log2.tsv, intervals.tsv,\n"
@@ -486,11 +490,13 @@ static int cmd_stats(int argc, char **argv)
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
         const char *value = NULL;
-        if ((strcmp(a, "--mc") == 0 || strcmp(a, "--bin") == 0 || strcmp(a, "--tsv") == 0) &&
+        if ((strcmp(a, "--mc") == 0 || strcmp(a, "--bin") == 0 || strcmp(a, "--tsv") == 0 ||
+             strcmp(a, "--from") == 0 || strcmp(a, "--to") == 0) &&
             i + 1 < argc)
             value = argv[++i];
         else if (strncmp(a, "--mc=", 5) == 0 || strncmp(a, "--bin=", 6) == 0 ||
-                 strncmp(a, "--tsv=", 6) == 0)
+                 strncmp(a, "--tsv=", 6) == 0 || strncmp(a, "--from=", 7) == 0 ||
+                 strncmp(a, "--to=", 5) == 0)
             value = strchr(a, '=') + 1;
         /* Ranges (finite, a bin centre, ...) are bk_stats_options_check's. */
         char *end = NULL;
@@ -508,6 +514,13 @@ static int cmd_stats(int argc, char **argv)
             if (errno || end == value || *end)
                 return usage_error("stats", "--bin needs a bin width 0 < DM <= 10, got '%s'",
                                    value);
+        } else if (value && (strncmp(a, "--from", 6) == 0 || strncmp(a, "--to", 4) == 0)) {
+            int from = strncmp(a, "--from", 6) == 0;
+            double t = strtod(value, &end);
+            if (errno || end == value || *end || !isfinite(t))
+                return usage_error("stats", "%s needs a time in s, got '%s'", from ? "--from" : "--to",
+                                   value);
+            *(from ? &opt.t_from : &opt.t_to) = t;
         } else if (value) {
             tsv_dir = value;
         } else if (strcmp(a, "--json") == 0) {
