@@ -896,6 +896,52 @@ static void test_restart_errors(void **state)
     assert_true(path_exists(out) && !path_exists(part));
 }
 
+/* The catalog's scripts on a 40-block chain whose ends fail 1 ms apart and slip at once
+ * (test_run_catalog.c's overlap scene): its first event holds two separate ruptures, which
+ * event_ruptures.sh counts; plot_mfd.sh draws both figures. */
+static void test_catalog_scripts(void **state)
+{
+    (void)state;
+    char path[512], out[512], cmd[2048];
+    char *text = NULL;
+    snprintf(path, sizeof path, "%s/ends.ini", tmpdir);
+    snprintf(out, sizeof out, "%s/ends.h5", tmpdir);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("[model]\nn_blocks = 40\ncoupling_stiffness = 100\n"
+          "[block]\nmass = 1\ndriver_stiffness = 1e4\n"
+          "[block.0]\nx_init = -2e-4\n[block.39]\nx_init = -1.99e-4\n"
+          "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
+          "[driver]\nvelocity = 1e-3\n[output]\ninterval = 0\n[run]\nt_end = 0.5\n",
+          f);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --quiet", path, out);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    const char *bin = bksim_binary();
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/event_ruptures.sh --table %s", bin, out);
+    assert_int_equal(run_command(cmd, &text), 0);
+    double t_start;
+    int n_blocks, ruptures;
+    assert_int_equal(sscanf(text, "%lf %d %d", &t_start, &n_blocks, &ruptures), 3);
+    assert_true(n_blocks >= 2 && ruptures == 2);
+    assert_non_null(strstr(text, "(100.0 %) hold two or more separate ruptures; 2 ruptures in all"));
+    free(text);
+    /* Without transitions there is nothing to count: an error, not a count of 0. */
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s/bare.h5 --set output.transitions=false --quiet "
+             "&& BKSIM=%s scripts/event_ruptures.sh %s/bare.h5", path, tmpdir, bin, tmpdir);
+    assert_int_equal(run_command(cmd, &text), 1);
+    assert_non_null(strstr(text, "transitions off"));
+    free(text);
+
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_mfd.sh -o %s/fig %s", bin, tmpdir, out);
+    assert_int_equal(run_command(cmd, &text), 0);
+    free(text);
+    snprintf(cmd, sizeof cmd, "%s/fig/ends_mfd.png", tmpdir);
+    assert_true(path_exists(cmd));
+    snprintf(cmd, sizeof cmd, "%s/fig/ends_spacetime.png", tmpdir);
+    assert_true(path_exists(cmd));
+}
+
 /* The benchmark's smoke run: every back-end on case B at three tolerances, all succeed
  * with the reference's stick-slip events and an error against the exact stepper that falls
  * as rtol tightens; and the whole script (sweep, scaling, long run, plots, tables). */
@@ -987,6 +1033,7 @@ int main(void)
         cmocka_unit_test(test_restart_equivalence),
         cmocka_unit_test(test_sigkill_restart_loop),
         cmocka_unit_test(test_restart_errors),
+        cmocka_unit_test(test_catalog_scripts),
         cmocka_unit_test(test_bench_smoke),
         cmocka_unit_test(test_readme_reference_current),
     };
