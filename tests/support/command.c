@@ -53,3 +53,14 @@ int run_command(const char *command, char **output)
         free(buf);
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
+
+void expect_command(const char *command, int status, const char *message)
+{
+    char *text = NULL;
+    int got = run_command(command, &text);
+    if (got != status || !strstr(text, message))
+        print_error("%s\n-> exit %d, expected %d with \"%s\":\n%s\n", command, got, status, message, text);
+    assert_int_equal(got, status);
+    assert_non_null(strstr(text, message));
+    free(text);
+}

@@ -8,5 +8,7 @@ const char *bksim_binary(void);
 /* Run a shell command, with "./bksim" standing for the binary under test; return its exit
  * status, with stdout+stderr in *output (malloc'ed) unless output is NULL. */
 int run_command(const char *command, char **output);
+/* Run command and require exit status `status` and `message` somewhere in its output. */
+void expect_command(const char *command, int status, const char *message);
 
 #endif
