@@ -249,6 +249,44 @@ int bk_h5_open_transitions(hid_t file, const char *path, hid_t *dset, hid_t *mem
     return BK_OK;
 }
 
+/* Rows [0, count) of the 1-D table dset (`table` names it in messages), `buffer_rows` of
+ * `row_size` bytes at a time through visit_row; closes mem and dset. */
+typedef int (*row_visit)(const void *row, unsigned long long index, void *user, bk_error *err);
+
+static int each_row(hid_t dset, hid_t mem, hsize_t count, size_t row_size, size_t buffer_rows,
+                    const char *path, const char *table, row_visit visit_row, void *user,
+                    bk_error *err)
+{
+    int rc = BK_OK;
+    char *buf = malloc(buffer_rows * row_size);
+    if (!buf)
+        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    for (hsize_t start = 0; rc == BK_OK && start < count; start += buffer_rows) {
+        size_t n = count - start < buffer_rows ? (size_t)(count - start) : buffer_rows;
+        if (bk_h5_read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
+            rc = H5_DAMAGED(err, "%s: damaged: %s rows %llu..%llu cannot be read", path, table,
+                            (unsigned long long)start, (unsigned long long)(start + n - 1));
+            break;
+        }
+        for (size_t k = 0; rc == BK_OK && k < n; ++k)
+            rc = visit_row(buf + k * row_size, (unsigned long long)(start + k), user, err);
+    }
+    free(buf);
+    CLOSE_IDS(0, mem, dset);
+    return rc;
+}
+
+typedef struct transition_visitor {
+    bk_h5_transition_visit visit;
+    void *user;
+} transition_visitor;
+
+static int visit_transition(const void *row, unsigned long long index, void *user, bk_error *err)
+{
+    const transition_visitor *v = user;
+    return v->visit(row, index, v->user, err);
+}
+
 int bk_h5_each_transition(hid_t file, const char *path, bk_h5_transition_visit visit, void *user,
                           hsize_t *count, bk_error *err)
 {
@@ -256,22 +294,9 @@ int bk_h5_each_transition(hid_t file, const char *path, bk_h5_transition_visit v
     int rc = bk_h5_open_transitions(file, path, &dset, &mem, count, err);
     if (rc != BK_OK)
         return rc;
-    bk_transition *buf = malloc(TRANSITION_BUFFER * sizeof *buf);
-    if (!buf)
-        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
-    for (hsize_t start = 0; rc == BK_OK && start < *count; start += TRANSITION_BUFFER) {
-        size_t n = *count - start < TRANSITION_BUFFER ? (size_t)(*count - start) : TRANSITION_BUFFER;
-        if (bk_h5_read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
-            rc = H5_DAMAGED(err, "%s: damaged: /transitions rows %llu..%llu cannot be read", path,
-                            (unsigned long long)start, (unsigned long long)(start + n - 1));
-            break;
-        }
-        for (size_t k = 0; rc == BK_OK && k < n; ++k)
-            rc = visit(&buf[k], (unsigned long long)(start + k), user, err);
-    }
-    free(buf);
-    CLOSE_IDS(0, mem, dset);
-    return rc;
+    transition_visitor v = {visit, user};
+    return each_row(dset, mem, *count, sizeof(bk_transition), TRANSITION_BUFFER, path,
+                    "/transitions", visit_transition, &v, err);
 }
 
 int bk_h5_read_transitions(const char *path, bk_transition **rows, size_t *count,
@@ -374,11 +399,6 @@ int bk_h5_load_stored_config(hid_t file, const char *path, bk_config **config, b
     return rc;
 }
 
-/* The fields of bksim's catalog, in the order of the table. */
-static const char *const event_fields[] = {"t_start",  "t_end",         "first_block", "n_blocks",
-                                           "left",     "right",         "n_episodes",  "potency",
-                                           "magnitude", "max_slip_rate", "stress_drop", "complete"};
-
 int bk_h5_open_events(hid_t file, const char *path, hid_t *dset, hid_t *mem, hsize_t *count,
                       bk_error *err)
 {
@@ -402,21 +422,39 @@ int bk_h5_open_events(hid_t file, const char *path, hid_t *dset, hid_t *mem, hsi
     else if (H5Tget_class(type) != H5T_COMPOUND || H5Sget_simple_extent_ndims(space) != 1 ||
              H5Sget_simple_extent_dims(space, dims, NULL) < 0)
         rc = BK_FAIL(err, BK_ERR_INVALID, "%s: /events is not a 1-D compound table", path);
-    for (size_t k = 0; rc == BK_OK && k < sizeof event_fields / sizeof event_fields[0]; ++k)
-        if (H5Tget_member_index(type, event_fields[k]) < 0)
-            rc = BK_FAIL(err, BK_ERR_INVALID,
-                         "%s: /events has no field '%s' (not a catalog written by bksim)", path,
-                         event_fields[k]);
-    CLOSE_IDS(0, space, type);
     if (rc == BK_OK && (*mem = bk_h5_event_type(0)) < 0)
         rc = H5_FAIL(err, "%s: cannot build the event type", path);
+    /* Every field of bksim's catalog (the memory type's members) must be in the file. */
+    int n_fields = rc == BK_OK ? H5Tget_nmembers(*mem) : 0;
+    for (int k = 0; rc == BK_OK && k < n_fields; ++k) {
+        char *name = H5Tget_member_name(*mem, (unsigned)k);
+        if (!name || H5Tget_member_index(type, name) < 0)
+            rc = BK_FAIL(err, BK_ERR_INVALID,
+                         "%s: /events has no field '%s' (not a catalog written by bksim)", path,
+                         name ? name : "?");
+        H5free_memory(name);
+    }
+    CLOSE_IDS(0, space, type);
     if (rc != BK_OK) {
+        bk_h5_close_id(*mem);
+        *mem = H5I_INVALID_HID;
         bk_h5_close_id(d);
         return rc;
     }
     *dset = d;
     *count = dims[0];
     return BK_OK;
+}
+
+typedef struct event_visitor {
+    bk_h5_event_visit visit;
+    void *user;
+} event_visitor;
+
+static int visit_event(const void *row, unsigned long long index, void *user, bk_error *err)
+{
+    const event_visitor *v = user;
+    return v->visit(row, index, v->user, err);
 }
 
 int bk_h5_each_event(hid_t file, const char *path, bk_h5_event_visit visit, void *user,
@@ -426,22 +464,9 @@ int bk_h5_each_event(hid_t file, const char *path, bk_h5_event_visit visit, void
     int rc = bk_h5_open_events(file, path, &dset, &mem, count, err);
     if (rc != BK_OK)
         return rc;
-    bk_event *buf = malloc(EVENT_BUFFER * sizeof *buf);
-    if (!buf)
-        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
-    for (hsize_t start = 0; rc == BK_OK && start < *count; start += EVENT_BUFFER) {
-        size_t n = *count - start < EVENT_BUFFER ? (size_t)(*count - start) : EVENT_BUFFER;
-        if (bk_h5_read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
-            rc = H5_DAMAGED(err, "%s: damaged: /events rows %llu..%llu cannot be read", path,
-                            (unsigned long long)start, (unsigned long long)(start + n - 1));
-            break;
-        }
-        for (size_t k = 0; rc == BK_OK && k < n; ++k)
-            rc = visit(&buf[k], (unsigned long long)(start + k), user, err);
-    }
-    free(buf);
-    CLOSE_IDS(0, mem, dset);
-    return rc;
+    event_visitor v = {visit, user};
+    return each_row(dset, mem, *count, sizeof(bk_event), EVENT_BUFFER, path, "/events",
+                    visit_event, &v, err);
 }
 
 int bk_h5_read_events(const char *path, bk_event **rows, size_t *count, bk_error *err)
