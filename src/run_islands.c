@@ -288,12 +288,16 @@ static int start_island(run_ctx *ctx, size_t id, double t)
 }
 
 /* The island's state at t into the chain's arrays: its own vector where it stands at t,
- * else dense output (t lies in its last step: see the scheduler in run.c). */
-static int unpack_island(run_ctx *ctx, run_island *isl, double t, double *work, double *dissipation)
+ * else dense output (t lies in its last step: see the scheduler in run.c); for an output
+ * row (for_row), the back-end's output-row interpolant where it has one. */
+static int unpack_island(run_ctx *ctx, run_island *isl, double t, int for_row, double *work,
+                         double *dissipation)
 {
     const double *y = isl->y;
     if (t != isl->t_reached) {
-        int rc = ctx->backend->interpolate(isl->solver, t, isl->y_probe, ctx->err);
+        const bk_solver_backend *backend = ctx->backend;
+        int rc = (for_row && backend->sample ? backend->sample : backend->interpolate)(
+            isl->solver, t, isl->y_probe, ctx->err);
         if (rc != BK_OK)
             return rc;
         y = isl->y_probe;
@@ -310,7 +314,7 @@ int bk_run_unpack_all(run_ctx *ctx, double t)
         if (!isl->live)
             continue;
         double w, d;
-        int rc = unpack_island(ctx, isl, t, &w, &d);
+        int rc = unpack_island(ctx, isl, t, 1, &w, &d);
         if (rc != BK_OK)
             return rc;
         work += w;
@@ -341,7 +345,7 @@ static int dissolve(run_ctx *ctx, size_t id, double t, int taken)
     run_island *isl = ctx->islands[id];
     if (!taken) {
         double work, dissipation;
-        int rc = unpack_island(ctx, isl, t, &work, &dissipation);
+        int rc = unpack_island(ctx, isl, t, 0, &work, &dissipation);
         if (rc != BK_OK)
             return rc;
         ctx->work_closed += work;
@@ -661,7 +665,7 @@ int bk_run_island_event(run_ctx *ctx, size_t id)
     size_t R = scene->roots_per_block;
     double t = isl->t_event;
     double work, dissipation;
-    int rc = unpack_island(ctx, isl, t, &work, &dissipation);
+    int rc = unpack_island(ctx, isl, t, 0, &work, &dissipation);
     if (rc != BK_OK)
         return rc;
     ctx->work_closed += work;

@@ -987,6 +987,26 @@ static void test_readme_reference_current(void **state)
     free(keys);
 }
 
+/* The output benchmark's smoke run: both tables, the writer's two scenes, and rows that
+ * cost CVODE and the exact stepper no evaluation at all (they interpolate). */
+static void test_bench_output_smoke(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/bksim_bench_output_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "scripts/bench_output.sh --quick %s", dir);
+    char *text = NULL;
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_non_null(strstr(text, "| case B, 2 s, 0.1 ms rows | 1 |"));
+    assert_non_null(strstr(text, "| resting chain, every field | 100 |"));
+    assert_non_null(strstr(text, "| exact | 1.000 | 1.000 | 1.000 | - | - | - |"));
+    assert_non_null(strstr(text, "| cvode_adams | 1.000 | 1.000 | 1.000 | 1.000 | 1.000 | 1.000 |"));
+    free(text);
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1005,6 +1025,7 @@ int main(void)
         cmocka_unit_test(test_restart_errors),
         cmocka_unit_test(test_catalog_scripts),
         cmocka_unit_test(test_bench_smoke),
+        cmocka_unit_test(test_bench_output_smoke),
         cmocka_unit_test(test_readme_reference_current),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);

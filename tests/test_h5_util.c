@@ -95,7 +95,7 @@ static void test_fail_keeps_hdf5_reason(void **state)
 static void test_transition_types(void **state)
 {
     (void)state;
-    hid_t mem = bk_h5_transition_type(0), disk = bk_h5_transition_type(1);
+    hid_t mem = bk_h5_transition_type(BK_H5_RECORD_STRUCT), disk = bk_h5_transition_type(BK_H5_RECORD_FILE);
     assert_true(mem >= 0 && disk >= 0);
     assert_int_equal(H5Tget_size(mem), sizeof(bk_transition));
     assert_int_equal(H5Tget_size(disk), 38); /* packed: 8 + 4 + 1 + 1 + 3 x 8 */

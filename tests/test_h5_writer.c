@@ -8,6 +8,7 @@
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <hdf5.h>
@@ -23,7 +24,7 @@ static void test_roundtrip_all_fields(void **state)
     output_fixture *f = *state;
     bk_config *c = synthetic_config(3, BK_FIELD_ALL, 1, 1);
     assert_int_equal(c->model->n_friction_state, 4);
-    const size_t rows = 1500, count = 5;
+    const size_t rows = 9000, count = 5;
     write_file(f->path, c, rows, count);
     assert_true(path_exists(f->path));
     assert_false(path_exists(part_path(f->path)));
@@ -103,11 +104,11 @@ static void test_roundtrip_all_fields(void **state)
     s = attr_string(d, "units");
     assert_string_equal(s, "m/s");
     free(s);
-    /* 1500 rows of 3 blocks span three 512-row chunks, unlimited in time. */
+    /* 9000 rows of 3 blocks span three 4096-row chunks, unlimited in time. */
     hid_t dcpl = H5Dget_create_plist(d);
     hsize_t chunk[2];
     assert_int_equal(H5Pget_chunk(dcpl, 2, chunk), 2);
-    assert_int_equal(chunk[0], 512);
+    assert_int_equal(chunk[0], 4096);
     assert_int_equal(chunk[1], 3);
     H5Pclose(dcpl);
     hid_t space = H5Dget_space(d);
@@ -163,7 +164,7 @@ static void test_abandon_keeps_part(void **state)
     assert_true(path_exists(part_path(f->path)));
     bk_sink sink = bk_h5_writer_sink(w);
     /* One flushed chunk plus rows still in the buffer: both must reach the file. */
-    write_rows(&sink, c, 700);
+    write_rows(&sink, c, 4700);
     write_transitions(&sink, 3);
     bk_run_stats stats = example_stats();
     bk_h5_writer_abandon(w, "integrator failure at t = 7", &stats);
@@ -171,8 +172,8 @@ static void test_abandon_keeps_part(void **state)
     assert_false(path_exists(f->path));
     const char *part = part_path(f->path);
     assert_true(path_exists(part));
-    check_series(part, "time", 700, 1, -1);
-    check_series(part, "x", 700, 3, W_X);
+    check_series(part, "time", 4700, 1, -1);
+    check_series(part, "x", 4700, 3, W_X);
     bk_transition *tr;
     size_t n_tr;
     assert_int_equal(bk_h5_read_transitions(part, &tr, &n_tr, &err), BK_OK);
@@ -181,7 +182,7 @@ static void test_abandon_keeps_part(void **state)
     hid_t file = H5Fopen(part, H5F_ACC_RDONLY, H5P_DEFAULT);
     assert_true(file >= 0);
     assert_int_equal(attr_llong(file, "complete"), 0);
-    assert_true(attr_double(file, "t_reached") == row_time(699));
+    assert_true(attr_double(file, "t_reached") == row_time(4699));
     char *s = attr_string(file, "error");
     assert_string_equal(s, "integrator failure at t = 7");
     free(s);
@@ -547,6 +548,56 @@ static void test_open_fails_cleanly(void **state)
     bk_config_free(c);
 }
 
+/* What a SIGKILL leaves: the last commit, made once a second of wall-clock time has passed
+ * (within COMMIT_CHECK_EVERY records), not one per chunk.  A child writes 100 rows and 3
+ * transitions, waits 1.2 s, writes 200 more rows and dies without closing; the .part holds
+ * every dataset cut at the same committed row, its transitions and a matching t_reached. */
+static void test_commit_by_wall_clock(void **state)
+{
+    output_fixture *f = *state;
+    bk_config *c = synthetic_config(3, BK_FIELD_ALL, 1, 0);
+    pid_t child = fork();
+    assert_true(child >= 0);
+    if (child == 0) {
+        bk_h5_writer *w;
+        bk_error err;
+        if (bk_h5_writer_open(&w, c, f->path, &err) != BK_OK)
+            _exit(3);
+        bk_sink sink = bk_h5_writer_sink(w);
+        write_rows(&sink, c, 100);
+        write_transitions(&sink, 3);
+        nanosleep(&(struct timespec){1, 200000000}, NULL);
+        write_row_range(&sink, c, 100, 200);
+        _exit(0);
+    }
+    int status;
+    assert_int_equal(waitpid(child, &status, 0), child);
+    assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    const char *part = part_path(f->path);
+    hid_t file = H5Fopen(part, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(file >= 0);
+    hid_t d = H5Dopen2(file, "time", H5P_DEFAULT);
+    hid_t space = H5Dget_space(d);
+    hsize_t dims[1];
+    H5Sget_simple_extent_dims(space, dims, NULL);
+    size_t rows = (size_t)dims[0];
+    H5Sclose(space);
+    H5Dclose(d);
+    assert_true(rows > 100 && rows <= 100 + 64);
+    assert_true(attr_double(file, "t_reached") == row_time(rows - 1));
+    H5Fclose(file);
+    check_series(part, "time", rows, 1, -1);
+    check_series(part, "x", rows, 3, W_X);
+    check_series(part, "cof", rows, 3, W_COF);
+    bk_transition *tr;
+    size_t n_tr;
+    bk_error err;
+    assert_int_equal(bk_h5_read_transitions(part, &tr, &n_tr, &err), BK_OK);
+    assert_int_equal(n_tr, 3);
+    free(tr);
+    bk_config_free(c);
+}
+
 int main(int argc, char **argv)
 {
     self_path = argv[0];
@@ -555,6 +606,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         OUTPUT_TEST(test_roundtrip_all_fields),
         OUTPUT_TEST(test_abandon_keeps_part),
+        OUTPUT_TEST(test_commit_by_wall_clock),
         OUTPUT_TEST(test_abandon_without_stats),
         OUTPUT_TEST(test_fields_subset),
         OUTPUT_TEST(test_energy_only),

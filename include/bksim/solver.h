@@ -81,8 +81,13 @@ typedef struct bk_solver_backend {
     /* One internal step toward t_stop; returns BK_STEP_* or a negative error. y (size n)
      * receives the state at *t_reached. */
     int (*step)(void *mem, double *t_reached, double *y, bk_error *err);
-    /* Dense output inside the last step: y(t) into y. */
+    /* Dense output inside the last step: y(t) into y, as accurate as the step (events and
+     * merges continue from it). */
     int (*interpolate)(void *mem, double t, double *y, bk_error *err);
+    /* Dense output for output rows only, inside the last step: within the bound the back-end
+     * states of interpolate's, at no cost in steps and few right-hand side evaluations.
+     * NULL: interpolate serves. */
+    int (*sample)(void *mem, double t, double *y, bk_error *err);
     /* Interval [t_lo, t_hi] of the last step (where interpolate is valid). */
     void (*last_step)(void *mem, double *t_lo, double *t_hi);
     /* After BK_STEP_ROOT: found[i] = +1 / -1 for roots crossed rising / falling, else 0. */

@@ -154,8 +154,8 @@ int bk_h5_sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
     int rc = bk_h5_writer_flush(w, err);
     if (rc != BK_OK)
         return rc;
-    bk_checkpoint_record rec = {w->cp_sequence + 1, (long long)w->rows_written,
-                                (long long)w->trans_written, w->trans_last_t};
+    bk_checkpoint_record rec = {w->cp_sequence + 1, (long long)w->rows,
+                                (long long)w->trans.written, w->trans_last_t};
     uint64_t checksum = bk_checkpoint_hash(cp, &rec);
     int created = 0, slot_created = 0;
     hid_t top = open_or_create_group(w->file, "checkpoint", &created);
@@ -313,7 +313,7 @@ static int slot_matches_data(hid_t file, const bk_checkpoint *cp, const bk_check
     hid_t table = H5Lexists(file, "transitions", H5P_DEFAULT) > 0
                       ? H5Dopen2(file, "transitions", H5P_DEFAULT)
                       : H5I_INVALID_HID;
-    hid_t mem = table < 0 ? H5I_INVALID_HID : bk_h5_transition_type(0);
+    hid_t mem = table < 0 ? H5I_INVALID_HID : bk_h5_transition_type(BK_H5_RECORD_STRUCT);
     long long count = mem < 0 ? -1 : leading_dim(table);
     bk_transition last;
     last.t = NAN;
@@ -589,10 +589,10 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
                              bk_series[i].name, (unsigned long long)rows);
         }
         if (rc == BK_OK && H5Lexists(w->file, "transitions", H5P_DEFAULT) > 0) {
-            int buffered = bk_h5_writer_transition_buffer(w);
-            w->trans_dset = H5Dopen2(w->file, "transitions", H5P_DEFAULT);
-            if (buffered < 0 || w->trans_dset < 0 ||
-                truncate_rows(w->trans_dset, (hsize_t)rec->transition_rows, w->trans_mem,
+            int buffered = bk_h5_writer_table(&w->trans, 0);
+            w->trans.dset = H5Dopen2(w->file, "transitions", H5P_DEFAULT);
+            if (buffered < 0 || w->trans.dset < 0 ||
+                truncate_rows(w->trans.dset, (hsize_t)rec->transition_rows, w->trans.mem,
                               sizeof(bk_transition)) < 0)
                 rc = H5_FAIL(err, "%s: cannot reopen /transitions at the checkpoint", w->part);
         }
@@ -603,15 +603,15 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
                          has_events ? "/events exists but the checkpoint holds no catalog"
                                     : "the checkpoint holds a catalog but there is no /events");
         if (rc == BK_OK && has_events) {
-            int buffered = bk_h5_writer_event_buffer(w);
-            w->ev_dset = H5Dopen2(w->file, "events", H5P_DEFAULT);
-            if (buffered < 0 || w->ev_dset < 0 ||
-                truncate_rows(w->ev_dset, (hsize_t)cp->catalog->events, w->ev_mem, sizeof(bk_event)) < 0)
+            int buffered = bk_h5_writer_table(&w->events, 1);
+            w->events.dset = H5Dopen2(w->file, "events", H5P_DEFAULT);
+            if (buffered < 0 || w->events.dset < 0 ||
+                truncate_rows(w->events.dset, (hsize_t)cp->catalog->events, w->events.mem, sizeof(bk_event)) < 0)
                 rc = H5_FAIL(err, "%s: cannot reopen /events at the checkpoint", w->part);
-            w->ev_written = (hsize_t)cp->catalog->events;
+            w->events.written = (hsize_t)cp->catalog->events;
         }
-        w->rows_written = rows;
-        w->trans_written = (hsize_t)rec->transition_rows;
+        w->rows = rows;
+        w->trans.written = (hsize_t)rec->transition_rows;
         w->trans_last_t = rec->last_transition_t;
         w->t_written = w->t_buffered = cp->t_last_row;
         /* The next checkpoint goes into the other slot: this one stays the fallback. */

@@ -20,16 +20,21 @@
 #include "bksim/output.h"
 #include "output/layout.h"
 
-/* Rows buffered in memory before an append; also the row count of a 2-D chunk.  A chunk
- * of a T x N dataset is capped at CHUNK_BYTES so wide chains keep chunks (and the buffers,
- * one chunk per dataset) bounded. */
-#define MAX_BUFFER_ROWS 512u
+/* Rows of a 2-D chunk, and of the buffer that fills one.  A chunk of a T x N dataset is
+ * capped at CHUNK_BYTES so wide chains keep chunks (and the buffers, one chunk per
+ * dataset) bounded. */
+#define MAX_BUFFER_ROWS 4096u
 #define CHUNK_BYTES (1u << 20)
-/* 1-D series are tiny per row; longer chunks keep the chunk index small on long runs.
- * Appends of fewer rows go through the per-dataset chunk cache (1 MiB by default). */
+/* 1-D series are tiny per row: their chunks (and buffers) hold this many rows, so that a
+ * chunk is written once, whole, whatever the width of the 2-D ones. */
 #define SERIES_1D_CHUNK 4096u
 #define TRANSITION_BUFFER 512u
 #define EVENT_BUFFER 256u
+/* Wall-clock seconds between two commits (H5Fflush: what is on disk becomes a readable
+ * file) while a run writes; a SIGKILL loses what came after the last one. */
+#define COMMIT_INTERVAL 1.0
+/* Records handed to the writer between two looks at the wall clock. */
+#define COMMIT_CHECK_EVERY 64u
 /* Doubles held in memory per block of rows while exporting or checking. */
 #define EXPORT_BUDGET (1u << 20)
 
@@ -40,8 +45,22 @@ typedef struct bk_h5_series {
     int rank;            /* 1 for T, 2 for T x N and T x S */
     size_t cols;         /* values per row */
     size_t elem;         /* bytes per value in memory */
-    unsigned char *buf;  /* buffer_rows x cols values */
+    size_t rows;         /* rows the buffer holds: one chunk */
+    size_t buffered;     /* rows in the buffer, not yet appended */
+    unsigned char *buf;  /* rows x cols values */
 } bk_h5_series;
+
+/* A table of packed records (/transitions, /events) and its buffer. */
+typedef struct bk_h5_table {
+    hid_t dset;          /* H5I_INVALID_HID when the table is not written */
+    hid_t mem;           /* the C struct's type, for reading back at a restart */
+    hid_t packed;        /* the buffer's type: the file's row, native members */
+    size_t record;       /* bytes per packed record */
+    size_t capacity;     /* records the buffer holds */
+    size_t buffered;
+    hsize_t written;     /* records appended to the dataset */
+    unsigned char *buf;
+} bk_h5_table;
 
 struct bk_h5_writer {
     char *path;
@@ -49,22 +68,15 @@ struct bk_h5_writer {
     hid_t file;
     size_t n_blocks;
     bk_h5_series s[BK_N_SERIES];
-    size_t buffer_rows;
-    size_t buffered;
-    hsize_t rows_written;
-    double t_buffered;   /* time of the last row handed to the sink */
-    double t_written;    /* time of the last row on disk */
-    hid_t trans_dset;
-    hid_t trans_mem;
-    bk_transition *trans_buf;
-    size_t trans_buffered;
-    hsize_t trans_written;
-    double trans_last_t; /* t of the last transition on disk */
-    hid_t ev_dset;       /* /events, H5I_INVALID_HID when the run keeps no catalog */
-    hid_t ev_mem;
-    bk_event *ev_buf;
-    size_t ev_buffered;
-    hsize_t ev_written;
+    size_t buffer_rows;  /* rows of a 2-D chunk */
+    hsize_t rows;        /* rows accepted; every series holds them, on disk or buffered */
+    double t_buffered;   /* time of the last row accepted */
+    double t_written;    /* time of the last row in the last commit */
+    bk_h5_table trans;
+    double trans_last_t; /* t of the last transition accepted */
+    bk_h5_table events;  /* dset invalid when the run keeps no catalog */
+    double last_commit;  /* wall clock (s) of the last commit */
+    unsigned uncounted;  /* records since the wall clock was last read */
     long long cp_sequence; /* of the last checkpoint written (0: none) */
     int cp_slot;         /* slot of /checkpoint the next checkpoint goes to */
     int failed;          /* a write failed: rows on disk may be ragged, accept no more */
@@ -78,14 +90,13 @@ int bk_h5_writer_new(bk_h5_writer **out, const char *path, bk_error *err);
 void bk_h5_writer_size(bk_h5_writer *w, const bk_model *model);
 /* Shape series i for this chain and allocate its row buffer; -1 when out of memory. */
 int bk_h5_writer_series(bk_h5_writer *w, int i, const bk_model *model);
-/* The transition buffer and its memory type; -1 on failure. */
-int bk_h5_writer_transition_buffer(bk_h5_writer *w);
-/* The event buffer and its memory type; -1 on failure. */
-int bk_h5_writer_event_buffer(bk_h5_writer *w);
+/* The buffer and memory types of /transitions (events = 0) or /events; -1 on failure. */
+int bk_h5_writer_table(bk_h5_table *table, int events);
 /* Close every id the writer holds; -1 if any close failed. */
 herr_t bk_h5_writer_close(bk_h5_writer *w);
 void bk_h5_writer_free(bk_h5_writer *w);
-/* Write buffered rows and transitions and flush HDF5's metadata (see h5_writer.c). */
+/* Commit: append everything buffered, record t_reached and flush HDF5's metadata, so that
+ * the file on disk is readable and consistent up to here (see h5_writer.c). */
 int bk_h5_writer_flush(bk_h5_writer *w, bk_error *err);
 /* The solver statistics as attributes of group "stats" in obj. */
 herr_t bk_h5_write_stats(hid_t obj, const bk_run_stats *stats);
@@ -136,10 +147,15 @@ herr_t bk_h5_read_numeric_attr(hid_t obj, const char *name, hid_t mem_type, void
 
 hid_t bk_h5_kind_file_type(bk_series_kind kind);
 hid_t bk_h5_kind_mem_type(bk_series_kind kind);
-/* The transition record in memory (bk_transition) or on disk (packed little-endian). */
-hid_t bk_h5_transition_type(int on_disk);
-/* The event record in memory (bk_event) or on disk (packed little-endian). */
-hid_t bk_h5_event_type(int on_disk);
+/* Where a record's members sit: the C struct (bk_transition, bk_event: for reading), the
+ * file's packed little-endian row, or that packed row with native members, which the writer
+ * fills (bk_h5_pack_*) so that on a little-endian machine HDF5 has nothing to convert. */
+typedef enum { BK_H5_RECORD_STRUCT, BK_H5_RECORD_FILE, BK_H5_RECORD_PACKED } bk_h5_record_layout;
+hid_t bk_h5_transition_type(bk_h5_record_layout layout);
+hid_t bk_h5_event_type(bk_h5_record_layout layout);
+/* The record as a packed row (BK_*_RECORD_BYTES bytes at row). */
+void bk_h5_pack_transition(const bk_transition *transition, unsigned char *row);
+void bk_h5_pack_event(const bk_event *event, unsigned char *row);
 
 /* ------------------------------------------------------------------- readers --- */
 

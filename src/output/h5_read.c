@@ -237,7 +237,7 @@ int bk_h5_open_transitions(hid_t file, const char *path, hid_t *dset, hid_t *mem
     if (space < 0 || H5Sget_simple_extent_ndims(space) != 1 ||
         H5Sget_simple_extent_dims(space, dims, NULL) < 0)
         rc = H5_FAIL(err, "%s: /transitions is not a 1-D table", path);
-    else if ((*mem = bk_h5_transition_type(0)) < 0)
+    else if ((*mem = bk_h5_transition_type(BK_H5_RECORD_STRUCT)) < 0)
         rc = H5_FAIL(err, "%s: cannot build the transition type", path);
     bk_h5_close_id(space);
     if (rc != BK_OK) {
@@ -422,7 +422,7 @@ int bk_h5_open_events(hid_t file, const char *path, hid_t *dset, hid_t *mem, hsi
     else if (H5Tget_class(type) != H5T_COMPOUND || H5Sget_simple_extent_ndims(space) != 1 ||
              H5Sget_simple_extent_dims(space, dims, NULL) < 0)
         rc = BK_FAIL(err, BK_ERR_INVALID, "%s: /events is not a 1-D compound table", path);
-    if (rc == BK_OK && (*mem = bk_h5_event_type(0)) < 0)
+    if (rc == BK_OK && (*mem = bk_h5_event_type(BK_H5_RECORD_STRUCT)) < 0)
         rc = H5_FAIL(err, "%s: cannot build the event type", path);
     /* Every field of bksim's catalog (the memory type's members) must be in the file. */
     int n_fields = rc == BK_OK ? H5Tget_nmembers(*mem) : 0;

@@ -312,33 +312,55 @@ hid_t bk_h5_kind_mem_type(bk_series_kind kind)
     return H5T_NATIVE_DOUBLE;
 }
 
-/* The transition record in memory (bk_transition) and on disk (packed little-endian). */
-hid_t bk_h5_transition_type(int on_disk)
+/* A record's members: where each sits in the C struct and in the packed file row. */
+typedef struct record_field {
+    const char *name;
+    size_t offset, packed_offset;
+    int kind; /* 0: double, 1: int32, 2: int8 */
+} record_field;
+
+static const record_field transition_fields[] = {
+    {"t", offsetof(bk_transition, t), 0, 0},
+    {"block", offsetof(bk_transition, block), 8, 1},
+    {"from", offsetof(bk_transition, from), 12, 2},
+    {"to", offsetof(bk_transition, to), 13, 2},
+    {"x", offsetof(bk_transition, x), 14, 0},
+    {"v", offsetof(bk_transition, v), 22, 0},
+    {"force", offsetof(bk_transition, force), 30, 0},
+};
+
+static const record_field event_fields[] = {
+    {"t_start", offsetof(bk_event, t_start), 0, 0},
+    {"t_end", offsetof(bk_event, t_end), 8, 0},
+    {"first_block", offsetof(bk_event, first_block), 16, 1},
+    {"n_blocks", offsetof(bk_event, n_blocks), 20, 1},
+    {"left", offsetof(bk_event, left), 24, 1},
+    {"right", offsetof(bk_event, right), 28, 1},
+    {"n_episodes", offsetof(bk_event, n_episodes), 32, 1},
+    {"potency", offsetof(bk_event, potency), 36, 0},
+    {"magnitude", offsetof(bk_event, magnitude), 44, 0},
+    {"max_slip_rate", offsetof(bk_event, max_slip_rate), 52, 0},
+    {"stress_drop", offsetof(bk_event, stress_drop), 60, 0},
+    {"complete", offsetof(bk_event, complete), 68, 2},
+};
+
+#define N_FIELDS(table) (sizeof table / sizeof table[0])
+
+static const size_t kind_size[] = {8, 4, 1};
+
+static hid_t record_type(const record_field *fields, size_t n, size_t struct_size,
+                         size_t packed_size, bk_h5_record_layout layout)
 {
-    hid_t type = H5Tcreate(H5T_COMPOUND, on_disk ? BK_TRANSITION_RECORD_BYTES : sizeof(bk_transition));
-    if (type < 0)
-        return type;
-    herr_t rc;
-    if (on_disk)
-        rc = (H5Tinsert(type, "t", 0, H5T_IEEE_F64LE) < 0 ||
-              H5Tinsert(type, "block", 8, H5T_STD_I32LE) < 0 ||
-              H5Tinsert(type, "from", 12, H5T_STD_I8LE) < 0 ||
-              H5Tinsert(type, "to", 13, H5T_STD_I8LE) < 0 ||
-              H5Tinsert(type, "x", 14, H5T_IEEE_F64LE) < 0 ||
-              H5Tinsert(type, "v", 22, H5T_IEEE_F64LE) < 0 ||
-              H5Tinsert(type, "force", 30, H5T_IEEE_F64LE) < 0)
-                 ? -1
-                 : 0;
-    else
-        rc = (H5Tinsert(type, "t", offsetof(bk_transition, t), H5T_NATIVE_DOUBLE) < 0 ||
-              H5Tinsert(type, "block", offsetof(bk_transition, block), H5T_NATIVE_INT32) < 0 ||
-              H5Tinsert(type, "from", offsetof(bk_transition, from), H5T_NATIVE_INT8) < 0 ||
-              H5Tinsert(type, "to", offsetof(bk_transition, to), H5T_NATIVE_INT8) < 0 ||
-              H5Tinsert(type, "x", offsetof(bk_transition, x), H5T_NATIVE_DOUBLE) < 0 ||
-              H5Tinsert(type, "v", offsetof(bk_transition, v), H5T_NATIVE_DOUBLE) < 0 ||
-              H5Tinsert(type, "force", offsetof(bk_transition, force), H5T_NATIVE_DOUBLE) < 0)
-                 ? -1
-                 : 0;
+    int packed = layout != BK_H5_RECORD_STRUCT;
+    hid_t type = H5Tcreate(H5T_COMPOUND, packed ? packed_size : struct_size);
+    herr_t rc = type < 0 ? -1 : 0;
+    for (size_t k = 0; rc >= 0 && k < n; ++k) {
+        int file = layout == BK_H5_RECORD_FILE;
+        hid_t member = fields[k].kind == 0 ? (file ? H5T_IEEE_F64LE : H5T_NATIVE_DOUBLE)
+                       : fields[k].kind == 1 ? (file ? H5T_STD_I32LE : H5T_NATIVE_INT32)
+                                             : (file ? H5T_STD_I8LE : H5T_NATIVE_INT8);
+        rc = H5Tinsert(type, fields[k].name, packed ? fields[k].packed_offset : fields[k].offset, member);
+    }
     if (rc < 0) {
         CLOSE_IDS(-1, type);
         return H5I_INVALID_HID;
@@ -346,38 +368,31 @@ hid_t bk_h5_transition_type(int on_disk)
     return type;
 }
 
-/* The event record in memory (bk_event) and on disk (packed little-endian). */
-hid_t bk_h5_event_type(int on_disk)
+static void pack(const record_field *fields, size_t n, const void *record, unsigned char *row)
 {
-    static const struct {
-        const char *name;
-        size_t offset, disk_offset;
-        int kind; /* 0: double, 1: int32, 2: int8 */
-    } fields[] = {
-        {"t_start", offsetof(bk_event, t_start), 0, 0},
-        {"t_end", offsetof(bk_event, t_end), 8, 0},
-        {"first_block", offsetof(bk_event, first_block), 16, 1},
-        {"n_blocks", offsetof(bk_event, n_blocks), 20, 1},
-        {"left", offsetof(bk_event, left), 24, 1},
-        {"right", offsetof(bk_event, right), 28, 1},
-        {"n_episodes", offsetof(bk_event, n_episodes), 32, 1},
-        {"potency", offsetof(bk_event, potency), 36, 0},
-        {"magnitude", offsetof(bk_event, magnitude), 44, 0},
-        {"max_slip_rate", offsetof(bk_event, max_slip_rate), 52, 0},
-        {"stress_drop", offsetof(bk_event, stress_drop), 60, 0},
-        {"complete", offsetof(bk_event, complete), 68, 2},
-    };
-    hid_t type = H5Tcreate(H5T_COMPOUND, on_disk ? BK_EVENT_RECORD_BYTES : sizeof(bk_event));
-    herr_t rc = type < 0 ? -1 : 0;
-    for (size_t k = 0; rc >= 0 && k < sizeof fields / sizeof fields[0]; ++k) {
-        hid_t member = fields[k].kind == 0 ? (on_disk ? H5T_IEEE_F64LE : H5T_NATIVE_DOUBLE)
-                       : fields[k].kind == 1 ? (on_disk ? H5T_STD_I32LE : H5T_NATIVE_INT32)
-                                             : (on_disk ? H5T_STD_I8LE : H5T_NATIVE_INT8);
-        rc = H5Tinsert(type, fields[k].name, on_disk ? fields[k].disk_offset : fields[k].offset, member);
-    }
-    if (rc < 0) {
-        CLOSE_IDS(-1, type);
-        return H5I_INVALID_HID;
-    }
-    return type;
+    for (size_t k = 0; k < n; ++k)
+        memcpy(row + fields[k].packed_offset, (const char *)record + fields[k].offset,
+               kind_size[fields[k].kind]);
+}
+
+hid_t bk_h5_transition_type(bk_h5_record_layout layout)
+{
+    return record_type(transition_fields, N_FIELDS(transition_fields), sizeof(bk_transition),
+                       BK_TRANSITION_RECORD_BYTES, layout);
+}
+
+hid_t bk_h5_event_type(bk_h5_record_layout layout)
+{
+    return record_type(event_fields, N_FIELDS(event_fields), sizeof(bk_event), BK_EVENT_RECORD_BYTES,
+                       layout);
+}
+
+void bk_h5_pack_transition(const bk_transition *transition, unsigned char *row)
+{
+    pack(transition_fields, N_FIELDS(transition_fields), transition, row);
+}
+
+void bk_h5_pack_event(const bk_event *event, unsigned char *row)
+{
+    pack(event_fields, N_FIELDS(event_fields), event, row);
 }

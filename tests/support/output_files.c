@@ -51,8 +51,13 @@ double row_time(size_t row) { return 0.01 * (double)row + 1e-13; }
 
 int8_t row_mode(size_t row, size_t col) { return (int8_t)((row / 100 + col) % 3) - 1; }
 
-/* Send rows [0, rows) through the sink; row 7k is an event row. */
 void write_rows(bk_sink *sink, const bk_config *c, size_t rows)
+{
+    write_row_range(sink, c, 0, rows);
+}
+
+/* Send rows [first, first + rows) through the sink; row 7k is an event row. */
+void write_row_range(bk_sink *sink, const bk_config *c, size_t first, size_t rows)
 {
     size_t n = c->model->n_blocks, s = c->model->n_friction_state;
     double *x = malloc(n * sizeof *x), *v = malloc(n * sizeof *v);
@@ -61,7 +66,7 @@ void write_rows(bk_sink *sink, const bk_config *c, size_t rows)
     int8_t *mode = malloc(n);
     assert_true(x && v && fr && cof && st && mode);
     bk_error err;
-    for (size_t r = 0; r < rows; ++r) {
+    for (size_t r = first; r < first + rows; ++r) {
         for (size_t b = 0; b < n; ++b) {
             x[b] = value(r, b, W_X);
             v[b] = value(r, b, W_V);

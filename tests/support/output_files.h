@@ -25,6 +25,8 @@ int8_t row_mode(size_t row, size_t col);
 
 /* Send rows [0, rows) through the sink; row 7k is an event row. */
 void write_rows(bk_sink *sink, const bk_config *c, size_t rows);
+/* Rows [first, first + rows), as write_rows writes them. */
+void write_row_range(bk_sink *sink, const bk_config *c, size_t first, size_t rows);
 /* Transition k of the synthetic sequence (times within [0, 0.2]), and the first count of
  * them through the sink. */
 bk_transition transition_at(size_t k);
