@@ -21,14 +21,10 @@
  *     the step; 12 resp. 5 right-hand side evaluations per call);
  *   gsl_msbdf: cubic Hermite on y and f at both ends (third degree, local error O(h^4);
  *     msbdf keeps its Nordsieck history private, so its own interpolant is out of reach).
- * That is for events and merges.  Output rows (sample) use a Hermite polynomial through the
- * step's ends and older step ends of the same start (y and f at each, known already: no
- * evaluation), of degree 11 / 7 / 5 (rk8pd / rkf45 / msbdf).  For the RK pairs the last
- * node's share of it estimates its error; where that exceeds atol_i + rtol |y_i| the row is
- * re-stepped as above and becomes a node inside the step.  Rate-and-state case B at
- * rtol 1e-8 with rows every 0.1 ms: 1.21 / 1.01 / 1.00 times the evaluations without rows
- * (re-stepping every row: 5.7 / 2.5), rows as close to a converged reference as re-stepped
- * ones (tests/test_backends.c).
+ * That is for events and merges.  Output rows (sample) come from a Hermite polynomial
+ * through this and older step ends (row_nodes.h), degree 11 / 7 / 5 for rk8pd / rkf45 /
+ * msbdf; an RK row whose error estimate exceeds atol_i + rtol |y_i| is re-stepped as above
+ * and becomes a node (README "Output rows cost no steps").
  *
  * Events, CVODE's conventions: after each step the root functions are evaluated at its
  * end; a function whose sign changed in its allowed direction (root_direction) crossed.
@@ -57,7 +53,7 @@
 #include "bksim/solver.h"
 #include "capacity.h"
 #include "gsl_shared.h"
-#include "solver/hermite.h"
+#include "solver/row_nodes.h"
 
 typedef enum { DENSE_RESTEP, DENSE_HERMITE } dense_kind;
 
@@ -75,13 +71,6 @@ static const gsl_variant variant_rk8pd = {"rk8pd", &gsl_odeiv2_step_rk8pd, 8, 0,
 static const gsl_variant variant_rkf45 = {"rkf45", &gsl_odeiv2_step_rkf45, 5, 0, DENSE_RESTEP, 1.0, 4};
 static const gsl_variant variant_msbdf = {"msbdf", &gsl_odeiv2_step_msbdf, 1, 1, DENSE_HERMITE, 0.1, 3};
 
-/* Older step ends kept for the output rows' polynomial (besides the last step's two), and
- * nodes inside the step that rows can add. */
-#define SAMPLE_HISTORY (BK_HERMITE_MAX_NODES - 2)
-#define MAX_INNER_NODES (BK_HERMITE_MAX_NODES - 2)
-/* A node closer than this fraction of the step to the next one is not used: close nodes
- * turn the steps' own errors into large errors of the polynomial's high derivatives. */
-#define MIN_NODE_GAP 0.125
 
 typedef struct gsl_backend {
     const gsl_variant *variant;
@@ -115,19 +104,7 @@ typedef struct gsl_backend {
     int stepped;                /* a step has been taken since the start */
     int pending;                /* a root was returned inside the step: scan the rest */
 
-    /* Output rows (sample): Hermite interpolation through the last step's ends, up to
-     * SAMPLE_HISTORY older step ends of this start, and nodes inside the step from
-     * re-steps when those are too few. */
-    double *sample_arena;
-    size_t sample_capacity;
-    size_t n_history;                       /* older nodes held, newest first */
-    double history_t[SAMPLE_HISTORY];
-    double *history_y[SAMPLE_HISTORY], *history_f[SAMPLE_HISTORY];
-    size_t n_inner;                         /* nodes inside the step, from re-steps */
-    double inner_t[MAX_INNER_NODES];
-    double *inner_y[MAX_INNER_NODES], *inner_f[MAX_INNER_NODES];
-    bk_hermite hermite;
-    double built_lo, built_hi;              /* the step the polynomial is for */
+    bk_row_nodes rows;          /* output rows' polynomial (sample) */
 
     bk_solver_counters count;   /* cumulative over starts */
     int rhs_status;             /* last failing return value of the problem's rhs */
@@ -507,8 +484,6 @@ static int initial_step(gsl_backend *b, double t0, double span, double *h)
     return GSL_SUCCESS;
 }
 
-static int reserve_sampling(gsl_backend *b);
-
 static int start(void *mem, const bk_ode_problem *problem, double t0, const double *y0,
                  const double *atol, size_t n, double t_stop, bk_error *err)
 {
@@ -528,11 +503,9 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     b->t_lo = b->t_hi = b->t_scan = t0;
     b->t_stop = t_stop;
     b->stepped = b->pending = 0;
-    b->n_history = 0;
-    b->built_lo = b->built_hi = NAN;
     /* Kept from the start, rows or not: a row's polynomial must not depend on when the
      * first row came (a restarted run writes the same rows as an uninterrupted one). */
-    if (reserve_sampling(b) != 0)
+    if (bk_row_nodes_start(&b->rows, n) != 0)
         return BK_FAIL(err, BK_ERR_NOMEM, "GSL %s: out of memory for dense output (n = %zu)",
                        b->variant->label, n);
     int rc = rhs_adapter(t0, y0, b->f_hi, b);
@@ -618,128 +591,6 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     return BK_OK;
 }
 
-/* --- output rows ------------------------------------------------------------------------ */
-
-static int interpolate(void *mem, double t, double *y, bk_error *err);
-
-/* The start of the step about to be replaced becomes the newest older node. */
-static void remember_step_start(gsl_backend *b)
-{
-    size_t n = b->n, last = SAMPLE_HISTORY - 1;
-    double *y = b->history_y[last], *f = b->history_f[last];
-    for (size_t k = last; k > 0; --k) {
-        b->history_t[k] = b->history_t[k - 1];
-        b->history_y[k] = b->history_y[k - 1];
-        b->history_f[k] = b->history_f[k - 1];
-    }
-    b->history_t[0] = b->t_lo;
-    b->history_y[0] = y;
-    b->history_f[0] = f;
-    memcpy(y, b->y_lo, n * sizeof *y);
-    memcpy(f, b->f_lo, n * sizeof *f);
-    if (b->n_history < SAMPLE_HISTORY)
-        b->n_history++;
-}
-
-static int reserve_sampling(gsl_backend *b)
-{
-    size_t n = b->n, arrays = 2 * SAMPLE_HISTORY + 2 * MAX_INNER_NODES;
-    if (!bk_capacity_fits(n, b->sample_capacity)) {
-        double *arena = malloc(arrays * n * sizeof *arena);
-        if (!arena)
-            return -1;
-        free(b->sample_arena);
-        b->sample_arena = arena;
-        b->sample_capacity = n;
-        b->n_history = 0; /* the nodes were in the old block */
-    }
-    double *next = b->sample_arena;
-    for (size_t k = 0; k < SAMPLE_HISTORY; ++k, next += 2 * b->sample_capacity) {
-        b->history_y[k] = next;
-        b->history_f[k] = next + b->sample_capacity;
-    }
-    for (size_t k = 0; k < MAX_INNER_NODES; ++k, next += 2 * b->sample_capacity) {
-        b->inner_y[k] = next;
-        b->inner_f[k] = next + b->sample_capacity;
-    }
-    return bk_hermite_reserve(&b->hermite, n);
-}
-
-/* The polynomial over the last step: its two ends, the nodes inside it that earlier rows
- * added, and older step ends while they are not too close, up to the variant's count. */
-static void build_sample_polynomial(gsl_backend *b)
-{
-    size_t want = b->variant->sample_nodes, k = 2;
-    double h = b->t_hi - b->t_lo;
-    double t[BK_HERMITE_MAX_NODES] = {b->t_lo, b->t_hi};
-    const double *ys[BK_HERMITE_MAX_NODES] = {b->y_lo, b->y_hi};
-    const double *fs[BK_HERMITE_MAX_NODES] = {b->f_lo, b->f_hi};
-    for (size_t j = 0; j < b->n_inner; ++j, ++k) {
-        t[k] = b->inner_t[j];
-        ys[k] = b->inner_y[j];
-        fs[k] = b->inner_f[j];
-    }
-    double oldest = b->t_lo;
-    for (size_t j = 0; j < b->n_history && k < want; ++j, ++k) {
-        if (oldest - b->history_t[j] < MIN_NODE_GAP * h)
-            break;
-        t[k] = oldest = b->history_t[j];
-        ys[k] = b->history_y[j];
-        fs[k] = b->history_f[j];
-    }
-    bk_hermite_build(&b->hermite, k, t, ys, fs);
-    b->built_lo = b->t_lo;
-    b->built_hi = b->t_hi;
-}
-
-/* y(t) by a fresh step from the step's start (the method's own accuracy), and f there;
- * kept as a node inside the step when there is room. */
-static int restep_node(gsl_backend *b, double t, double *y)
-{
-    int keep = b->n_inner < MAX_INNER_NODES;
-    double *yt = keep ? b->inner_y[b->n_inner] : y, *ft = keep ? b->inner_f[b->n_inner] : NULL;
-    memcpy(yt, b->y_lo, b->n * sizeof *yt);
-    if (gsl_odeiv2_step_apply(b->stepper, b->t_lo, t - b->t_lo, yt, b->yerr, b->f_lo, ft, &b->sys) !=
-        GSL_SUCCESS)
-        return -1;
-    if (keep) {
-        memcpy(y, yt, b->n * sizeof *y);
-        b->inner_t[b->n_inner++] = t;
-        build_sample_polynomial(b);
-    }
-    return 0;
-}
-
-/* Rows from the Hermite polynomial when the last node's share of it (the error estimate)
- * is within the tolerance, atol_i + rtol |y_i|, in every component; else (RK) from a fresh
- * step from the step's start, which becomes a node, so a step needs few of them. */
-static int sample(void *mem, double t, double *y, bk_error *err)
-{
-    gsl_backend *b = mem;
-    if (t == b->t_hi || t == b->t_lo || !(t > b->t_lo && t < b->t_hi)) {
-        /* The ends are exact; outside the step, interpolate says what is wrong. */
-        return interpolate(mem, t, y, err);
-    }
-    if (b->built_lo != b->t_lo || b->built_hi != b->t_hi) {
-        b->n_inner = 0;
-        build_sample_polynomial(b);
-    }
-    double *tail = b->work2;
-    bk_hermite_eval(&b->hermite, t, y, tail);
-    if (b->variant->dense != DENSE_RESTEP)
-        return BK_OK;
-    for (size_t i = 0; i < b->n; ++i) {
-        if (fabs(tail[i]) <= b->atol[i] + b->options.rtol * fabs(y[i]))
-            continue;
-        b->rhs_status = 0;
-        if (restep_node(b, t, y) != 0)
-            return BK_FAIL(err, BK_ERR_SOLVER, "GSL %s: dense output failed at t = %.17g s (%d)",
-                           b->variant->label, t, b->rhs_status);
-        break;
-    }
-    return BK_OK;
-}
-
 /* --- stepping -------------------------------------------------------------------------- */
 
 static int step_failed(gsl_backend *b, int status, double t, bk_error *err)
@@ -785,7 +636,7 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
 
     /* One step from the end of the last. */
     if (b->t_hi > b->t_lo)
-        remember_step_start(b);
+        bk_row_nodes_push(&b->rows, b->t_lo, b->y_lo, b->f_lo);
     memcpy(b->y_lo, b->y_hi, n * sizeof *y);
     memcpy(b->f_lo, b->f_hi, n * sizeof *y);
     b->t_lo = b->t_hi;
@@ -854,6 +705,45 @@ static int interpolate(void *mem, double t, double *y, bk_error *err)
     return BK_OK;
 }
 
+/* Rows from the Hermite polynomial when the last node's share of it (the error estimate)
+ * is within the tolerance, atol_i + rtol |y_i|, in every component; else (RK) from a fresh
+ * step from the step's start, which becomes a node, so a step needs few of them. */
+static int sample(void *mem, double t, double *y, bk_error *err)
+{
+    gsl_backend *b = mem;
+    if (t == b->t_hi || t == b->t_lo || !(t > b->t_lo && t < b->t_hi)) {
+        /* The ends are exact; outside the step, interpolate says what is wrong. */
+        return interpolate(mem, t, y, err);
+    }
+    bk_row_nodes *rows = &b->rows;
+    bk_row_nodes_prepare(rows, b->variant->sample_nodes, b->t_lo, b->y_lo, b->f_lo, b->t_hi, b->y_hi,
+                         b->f_hi);
+    double *tail = b->work2;
+    bk_hermite_eval(&rows->poly, t, y, tail);
+    if (b->variant->dense != DENSE_RESTEP)
+        return BK_OK;
+    size_t i = 0;
+    while (i < b->n && fabs(tail[i]) <= b->atol[i] + b->options.rtol * fabs(y[i]))
+        ++i;
+    if (i == b->n)
+        return BK_OK;
+    /* A fresh step from the step's start (the method's own accuracy), and f at its end:
+     * a node inside the step while there is room. */
+    double *y_node = y, *f_node = NULL;
+    int keep = bk_row_nodes_inner(rows, &y_node, &f_node);
+    memcpy(y_node, b->y_lo, b->n * sizeof *y_node);
+    b->rhs_status = 0;
+    if (gsl_odeiv2_step_apply(b->stepper, b->t_lo, t - b->t_lo, y_node, b->yerr, b->f_lo, f_node,
+                              &b->sys) != GSL_SUCCESS)
+        return BK_FAIL(err, BK_ERR_SOLVER, "GSL %s: dense output failed at t = %.17g s (%d)",
+                       b->variant->label, t, b->rhs_status);
+    if (keep) {
+        memcpy(y, y_node, b->n * sizeof *y);
+        bk_row_nodes_add_inner(rows, t);
+    }
+    return BK_OK;
+}
+
 static void last_step(void *mem, double *t_lo, double *t_hi)
 {
     gsl_backend *b = mem;
@@ -884,8 +774,7 @@ static void destroy(void *mem)
     free_steppers(b);
     gsl_root_fsolver_free(b->brent);
     free_arrays(b);
-    free(b->sample_arena);
-    bk_hermite_free(&b->hermite);
+    bk_row_nodes_free(&b->rows);
     free(b);
 }
 
