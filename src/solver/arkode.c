@@ -199,7 +199,9 @@ static bk_solver_counters this_start(const arkode_backend *ark)
     if (ark->arkode) {
         ARKStepGetNumSteps(ark->arkode, &steps);
         ARKStepGetNumRhsEvals(ark->arkode, &fe, &fi);
-        ARKStepGetNumGEvals(ark->arkode, &roots);
+        /* ARKODE 6.4's RootInit with no functions leaves this count uninitialised. */
+        if (ark->base.n_roots > 0)
+            ARKStepGetNumGEvals(ark->arkode, &roots);
         ARKStepGetNumErrTestFails(ark->arkode, &fails);
         if (implicit_fn(ark)) {
             ARKStepGetNumNonlinSolvIters(ark->arkode, &iters);
