@@ -61,10 +61,10 @@ build-asan/tests/test_%: build-asan/tests/test_%.o $(call objs,build-asan,$(TEST
 
 # Tests run from the repository root (they read configs/ and need ./bksim for CLI tests).
 test: test-plain test-asan
-test-plain: bksim build/bench/bksim_bench build/bench/h5_plain $(TESTS)
+test-plain: bksim build/bench/bksim_bench build/bench/h5_plain build/bench/exact_rows $(TESTS)
 	@scripts/run_tests.sh build/tests $(TESTS)
 # The CLI tests run the sanitizer build of bksim too (BKSIM, relative to the repository root).
-test-asan: build-asan/bksim build/bench/bksim_bench build/bench/h5_plain $(TESTS_ASAN)
+test-asan: build-asan/bksim build/bench/bksim_bench build/bench/h5_plain build/bench/exact_rows $(TESTS_ASAN)
 	@BKSIM=build-asan/bksim BK_TEST_TIME_SCALE=10 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
 	 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
@@ -95,7 +95,11 @@ build/bench/bksim_bench: bench/bench.c build/libbksim.a
 build/bench/h5_plain: bench/h5_plain.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -o $@ $< $(LDLIBS)
-bench: bksim build/bench/bksim_bench build/bench/h5_plain
+# The exact stepper's rows on one long slipping cluster: the series against the modal sum.
+build/bench/exact_rows: bench/exact_rows.c tests/support/linear_chain.c build/libbksim.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) -Itests/support $(CFLAGS) -o $@ $^ $(LDLIBS)
+bench: bksim build/bench/bksim_bench build/bench/h5_plain build/bench/exact_rows
 	scripts/bench.sh
 
 # Fuzz the config loader with libFuzzer (clang): make fuzz FUZZ_SECONDS=600.  The working

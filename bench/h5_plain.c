@@ -4,9 +4,12 @@
  *
  *   h5_plain SOURCE.h5 DEST.h5
  *
- * Reads every dataset of SOURCE's root group into memory first (not timed), then times
- * H5Fcreate .. H5Fclose and an fsync of DEST, as bksim makes its output durable before
- * renaming it.  Prints one line: rows (of /time), bytes written, seconds. */
+ * Reads every dataset of SOURCE's root group into memory first, then times H5Fcreate ..
+ * H5Fclose and an fsync of DEST, as bksim makes its output durable before renaming it.
+ * Prints one line: rows (of /time), bytes written, seconds (the writing), read_seconds
+ * (main's start to the data in memory), so that a caller timing the whole process can take
+ * the reading out and keep what a program holding the data would pay: start-up, HDF5's
+ * initialisation, the writing, exit. */
 #include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -74,6 +77,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: %s SOURCE.h5 DEST.h5\n", argv[0]);
         return 2;
     }
+    double entered = now();
     static collection c;
     hid_t source = H5Fopen(argv[1], H5F_ACC_RDONLY, H5P_DEFAULT);
     if (source < 0 || H5Literate(source, H5_INDEX_NAME, H5_ITER_INC, NULL, load, &c) < 0 || c.failed) {
@@ -113,7 +117,8 @@ int main(int argc, char **argv)
     }
     close(fd);
     double seconds = now() - start;
-    printf("rows %lld bytes %zu seconds %.6f\n", rows, bytes, seconds);
+    printf("rows %lld bytes %zu seconds %.6f read_seconds %.6f\n", rows, bytes, seconds,
+           start - entered);
     for (size_t k = 0; k < c.n; ++k) {
         free(c.items[k].data);
         H5Tclose(c.items[k].type);

@@ -987,8 +987,9 @@ static void test_readme_reference_current(void **state)
     free(keys);
 }
 
-/* The output benchmark's smoke run: both tables, the writer's two scenes, and rows that
- * cost CVODE and the exact stepper no evaluation at all (they interpolate). */
+/* The output benchmark's smoke run: its three tables, the writer's two scenes, rows that
+ * cost CVODE and the exact stepper no evaluation at all (they interpolate), and the exact
+ * stepper's rows on a 256-block cluster. */
 static void test_bench_output_smoke(void **state)
 {
     (void)state;
@@ -1002,6 +1003,8 @@ static void test_bench_output_smoke(void **state)
     assert_non_null(strstr(text, "| resting chain, every field | 100 |"));
     assert_non_null(strstr(text, "| exact | 1.000 | 1.000 | 1.000 | - | - | - |"));
     assert_non_null(strstr(text, "| cvode_adams | 1.000 | 1.000 | 1.000 | 1.000 | 1.000 | 1.000 |"));
+    assert_non_null(strstr(text, "| blocks in the cluster |"));
+    assert_non_null(strstr(text, "\n| 256 | "));
     free(text);
     snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
     assert_int_equal(system(cmd), 0);

@@ -144,7 +144,7 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->local = s->indices + p + 1;
     eb->parent = s->indices + 2 * (p + 1);
 
-    size_t need = 2 * n + 14 * p + 4 * m * p + 2 * m + 1;
+    size_t need = 3 * n + 19 * p + 4 * m * p + 2 * m + 2;
     double *arena = bk_fit_buffer(eb->arena, &eb->arena_cap, need, sizeof *arena);
     if (!arena)
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu components", n);
@@ -166,6 +166,12 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->accel_rate = a, a += p;
     eb->row_sum = a, a += p;
     eb->row_scale = a, a += p;
+    eb->yc = a, a += n;
+    eb->even = a, a += p;
+    eb->odd = a, a += p;
+    eb->next_even = a, a += p;
+    eb->next_odd = a, a += p;
+    eb->cluster_omega = a, a += p + 1;
     eb->P = a, a += m * p;
     eb->Q = a, a += m * p;
     eb->P_modal = a, a += m * p;
@@ -173,7 +179,7 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->qdot0 = a, a += m;
     eb->q_rate = a;
 
-    size_t *own_indices = bk_fit_buffer(eb->indices, &eb->indices_cap, 4 * (p + 1), sizeof *own_indices);
+    size_t *own_indices = bk_fit_buffer(eb->indices, &eb->indices_cap, 6 * (p + 1), sizeof *own_indices);
     if (!own_indices)
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu pairs", p);
     eb->indices = own_indices;
@@ -181,7 +187,9 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->members = ix, ix += p + 1;
     eb->first = ix, ix += p + 1;
     eb->offset = ix, ix += p + 1;
-    eb->uniform = ix;
+    eb->uniform = ix, ix += p + 1;
+    eb->series = ix, ix += p + 1;
+    eb->row_start = ix;
 
     if (n_roots > 0 && !bk_capacity_fits(n_roots, eb->roots_cap)) {
         free(eb->direction);
@@ -231,6 +239,8 @@ static void destroy(void *mem)
     free(eb->arena);
     free(eb->indices);
     free(eb->matrices);
+    free(eb->row_col);
+    free(eb->row_value);
     free(eb->direction);
     free(eb->sign);
     free(eb->found);
@@ -290,13 +300,17 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     memset(eb->P, 0, eb->m * p * sizeof *eb->P);
     memset(eb->Q, 0, eb->m * p * sizeof *eb->Q);
 
-    if ((rc = bk_exact_read_problem(eb, err)) == BK_OK)
-        rc = bk_exact_modes(eb, err);
+    if ((rc = bk_exact_read_problem(eb, err)) == BK_OK && (rc = bk_exact_modes(eb, err)) == BK_OK)
+        rc = bk_exact_rows_prepare(eb, err);
     /* the shared work space now serves other instances */
     eb->f0 = eb->probe = eb->scale = eb->delta = eb->predicted = eb->work = NULL;
     eb->cluster_of = eb->local = eb->parent = NULL;
     if (rc != BK_OK)
         return rc;
+    if (eb->n_series > 0) {
+        memcpy(eb->yc, y0, 2 * p * sizeof *y0);
+        eb->tc = t0;
+    }
 
     if (eb->n_roots > 0) {
         memcpy(eb->direction, problem->root_direction, eb->n_roots * sizeof *eb->direction);
@@ -548,13 +562,24 @@ static int find_roots(exact_backend *eb, double lo, double hi, double *t_root, b
     return BK_FAIL(err, BK_ERR_SOLVER, "exact stepper: cannot separate the roots near t = %.17g s", lo);
 }
 
+/* The step ends at t with state y: the centre of the rows' series. */
+static void reached(exact_backend *eb, double t, const double *y)
+{
+    eb->t_now = eb->t_hi = t;
+    if (eb->n_series > 0) {
+        memcpy(eb->yc, y, 2 * eb->p * sizeof *y);
+        eb->tc = t;
+    }
+}
+
 static int step(void *mem, double *t_reached, double *y, bk_error *err)
 {
     exact_backend *eb = mem;
     double lo = eb->t_now;
     if (lo >= eb->t_stop) {
-        eb->t_lo = eb->t_hi = eb->t_stop;
+        eb->t_lo = eb->t_stop;
         bk_exact_state(eb, eb->t_stop, y);
+        reached(eb, eb->t_stop, y);
         *t_reached = eb->t_stop;
         return BK_STEP_STOP;
     }
@@ -575,26 +600,41 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
         return status;
     eb->t_lo = lo;
     if (status == 1) {
-        eb->t_now = eb->t_hi = t_root;
         bk_exact_state(eb, t_root, y);
+        reached(eb, t_root, y);
         *t_reached = t_root;
         return BK_STEP_ROOT;
     }
     update_signs(eb, eb->g_hi);
-    eb->t_now = eb->t_hi = hi;
     bk_exact_state(eb, hi, y);
+    reached(eb, hi, y);
     *t_reached = hi;
     return hi == eb->t_stop ? BK_STEP_STOP : BK_STEP_OK;
+}
+
+static int outside(const exact_backend *eb, double t, bk_error *err)
+{
+    return BK_FAIL(err, BK_ERR_SOLVER,
+                   "exact stepper: t = %.17g s is outside the solution [%.17g, %.17g] s", t, eb->t0,
+                   eb->t_stop);
 }
 
 static int interpolate(void *mem, double t, double *y, bk_error *err)
 {
     exact_backend *eb = mem;
     if (!(t >= eb->t0 && t <= eb->t_stop))
-        return BK_FAIL(err, BK_ERR_SOLVER,
-                       "exact stepper: t = %.17g s is outside the solution [%.17g, %.17g] s", t,
-                       eb->t0, eb->t_stop);
+        return outside(eb, t, err);
     bk_exact_state(eb, t, y);
+    return BK_OK;
+}
+
+/* Output rows: exact like interpolate's, every cluster in O(its size). */
+static int sample(void *mem, double t, double *y, bk_error *err)
+{
+    exact_backend *eb = mem;
+    if (!(t >= eb->t0 && t <= eb->t_stop))
+        return outside(eb, t, err);
+    bk_exact_row_state(eb, t, y);
     return BK_OK;
 }
 
@@ -626,6 +666,7 @@ const bk_solver_backend bk_solver_exact = {
     .start = start,
     .step = step,
     .interpolate = interpolate,
+    .sample = sample,
     .last_step = last_step,
     .root_info = root_info,
     .counters = counters,

@@ -91,6 +91,18 @@ typedef struct exact_backend {
     int jacobian_status;
     size_t bad_row, bad_col;
 
+    /* Output rows of large clusters from the Taylor series about the last step end
+     * (exact_rows.c): K of their pairs as compressed rows, the state at that step end, the
+     * series' work vectors. */
+    size_t *series;             /* per cluster: its rows come from the series */
+    size_t n_series;            /* clusters whose rows do */
+    double *cluster_omega;      /* per cluster: its largest angular frequency */
+    size_t *row_start, *row_col;/* p + 1; one per coupling of those clusters */
+    double *row_value;
+    size_t row_cap;             /* capacity of row_col and row_value */
+    double *yc, tc;             /* n: the state at the last step end, and its time */
+    double *even, *odd, *next_even, *next_odd; /* p each */
+
     /* Root functions. */
     size_t roots_cap;
     int *direction;
@@ -114,5 +126,15 @@ int bk_exact_reserve_work(exact_backend *eb, size_t largest, bk_error *err);
 /* exact_modes.c: clusters and their modes (after bk_exact_read_problem); the exact state at t. */
 int bk_exact_modes(exact_backend *eb, bk_error *err);
 void bk_exact_state(exact_backend *eb, double t, double *y);
+/* exact_modes.c, bk_exact_state's three parts: the modes' amplitudes at tau = t - t0 (O(p)),
+ * one cluster's pairs from them (O(size^2), O(size) when uniform), the quadratures (O(m p)). */
+void bk_exact_modal_amplitudes(exact_backend *eb, double tau);
+void bk_exact_cluster_state(const exact_backend *eb, size_t cl, double *y);
+void bk_exact_quadratures(const exact_backend *eb, double tau, double *y);
+/* exact_rows.c: which clusters' rows come from the series, and their K (after
+ * bk_exact_modes, while the couplings are in the shared work space); the state at t for an
+ * output row, every cluster in O(its size). */
+int bk_exact_rows_prepare(exact_backend *eb, bk_error *err);
+void bk_exact_row_state(exact_backend *eb, double t, double *y);
 
 #endif

@@ -46,12 +46,10 @@ static void basis(double w, double tau, double phi[5])
     }
 }
 
-/* The exact state at time t into y (size n): O(p) modes, O(sum p_i^2) back to the pairs. */
-void bk_exact_state(exact_backend *eb, double t, double *y)
+/* Every mode's eta, eta' - c and their integrals at tau = t - t0: O(p). */
+void bk_exact_modal_amplitudes(exact_backend *eb, double tau)
 {
-    size_t p = eb->p, m = eb->m;
-    double tau = t - eb->t0;
-    for (size_t k = 0; k < p; ++k) {
+    for (size_t k = 0; k < eb->p; ++k) {
         double ck = eb->c[k], gk = eb->g[k], dk = eb->d[k];
         if (ck == 0.0 && gk == 0.0 && dk == 0.0) { /* idle (all but one mode of a uniform cluster) */
             eb->eta[k] = eb->deta[k] = eb->ieta[k] = eb->idv[k] = 0.0;
@@ -64,37 +62,56 @@ void bk_exact_state(exact_backend *eb, double t, double *y)
         eb->ieta[k] = ck * phi[2] + gk * phi[3] + dk * phi[4];
         eb->idv[k] = (dk - w2 * ck) * phi[3] + gk * phi[2];
     }
-    for (size_t cl = 0; cl < eb->n_clusters; ++cl) {
-        size_t first = eb->first[cl], size = eb->first[cl + 1] - first;
-        const double *T = &eb->T[eb->offset[cl]];
-        const double *eta = &eb->eta[first], *deta = &eb->deta[first];
-        if (eb->uniform[cl]) {
-            for (size_t r = 0; r < size; ++r) {
-                size_t i = eb->members[first + r];
-                y[2 * i] = eb->y0[2 * i] + eta[0];
-                y[2 * i + 1] = eb->y0[2 * i + 1] + deta[0];
-            }
-            continue;
-        }
+}
+
+/* Cluster cl's pairs from the amplitudes: O(size) for a uniform cluster, else O(size^2). */
+void bk_exact_cluster_state(const exact_backend *eb, size_t cl, double *y)
+{
+    size_t first = eb->first[cl], size = eb->first[cl + 1] - first;
+    const double *T = &eb->T[eb->offset[cl]];
+    const double *eta = &eb->eta[first], *deta = &eb->deta[first];
+    if (eb->uniform[cl]) {
         for (size_t r = 0; r < size; ++r) {
-            const double *Tr = &T[r * size];
-            double u = 0.0, dv = 0.0;
-            for (size_t k = 0; k < size; ++k) {
-                u += Tr[k] * eta[k];
-                dv += Tr[k] * deta[k];
-            }
             size_t i = eb->members[first + r];
-            y[2 * i] = eb->y0[2 * i] + u;
-            y[2 * i + 1] = eb->y0[2 * i + 1] + dv;
+            y[2 * i] = eb->y0[2 * i] + eta[0];
+            y[2 * i + 1] = eb->y0[2 * i + 1] + deta[0];
         }
+        return;
     }
-    for (size_t j = 0; j < m; ++j) {
+    for (size_t r = 0; r < size; ++r) {
+        const double *Tr = &T[r * size];
+        double u = 0.0, dv = 0.0;
+        for (size_t k = 0; k < size; ++k) {
+            u += Tr[k] * eta[k];
+            dv += Tr[k] * deta[k];
+        }
+        size_t i = eb->members[first + r];
+        y[2 * i] = eb->y0[2 * i] + u;
+        y[2 * i + 1] = eb->y0[2 * i + 1] + dv;
+    }
+}
+
+/* The quadratures from the amplitudes: O(m p). */
+void bk_exact_quadratures(const exact_backend *eb, double tau, double *y)
+{
+    size_t p = eb->p;
+    for (size_t j = 0; j < eb->m; ++j) {
         const double *Pj = &eb->P_modal[j * p], *Qj = &eb->Q_modal[j * p];
         double sum = 0.0;
         for (size_t k = 0; k < p; ++k)
             sum += Pj[k] * eb->ieta[k] + Qj[k] * eb->idv[k];
         y[2 * p + j] = eb->y0[2 * p + j] + (eb->qdot0[j] + 0.5 * eb->q_rate[j] * tau) * tau + sum;
     }
+}
+
+/* The exact state at time t into y (size n): O(p) modes, O(sum p_i^2) back to the pairs. */
+void bk_exact_state(exact_backend *eb, double t, double *y)
+{
+    double tau = t - eb->t0;
+    bk_exact_modal_amplitudes(eb, tau);
+    for (size_t cl = 0; cl < eb->n_clusters; ++cl)
+        bk_exact_cluster_state(eb, cl, y);
+    bk_exact_quadratures(eb, tau, y);
 }
 
 static int reserve_matrices(exact_backend *eb, size_t total, size_t largest, bk_error *err)
