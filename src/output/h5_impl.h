@@ -76,6 +76,8 @@ struct bk_h5_writer {
     double trans_last_t; /* t of the last transition accepted */
     bk_h5_table events;  /* dset invalid when the run keeps no catalog */
     double last_commit;  /* wall clock (s) of the last commit */
+    int part_fd;         /* the .part opened for write-behind (-1: not yet) */
+    size_t unsynced;     /* bytes appended since the last write-behind */
     unsigned uncounted;  /* records since the wall clock was last read */
     long long cp_sequence; /* of the last checkpoint written (0: none) */
     int cp_slot;         /* slot of /checkpoint the next checkpoint goes to */

@@ -1,5 +1,6 @@
 /* The file-system side of an output file: its ".part" name while a run writes it, the
  * directories it goes in, and the durable rename that publishes it.  Free of HDF5. */
+#define _GNU_SOURCE /* sync_file_range */
 #include "output/paths.h"
 
 #include <errno.h>
@@ -83,6 +84,16 @@ static int sync_path(const char *path)
     int e = fsync(fd) == 0 || errno == EINVAL ? 0 : errno;
     close(fd);
     return e;
+}
+
+void bk_output_write_behind(int fd)
+{
+#ifdef SYNC_FILE_RANGE_WRITE
+    /* Best effort: the final fsync still makes the file durable whatever happens here. */
+    (void)sync_file_range(fd, 0, 0, SYNC_FILE_RANGE_WRITE);
+#else
+    (void)fd;
+#endif
 }
 
 /* The rename of a finished file, made durable: H5Fclose leaves the data in the page cache,

@@ -8,5 +8,9 @@
 int bk_output_make_parent_dirs(const char *path, bk_error *err);
 /* Sync part to disk, rename it to path, and sync the directory (best effort). */
 int bk_output_durable_rename(const char *part, const char *path, bk_error *err);
+/* Start writing the dirty pages of the open file fd to disk, without waiting (Linux's
+ * sync_file_range; nothing elsewhere): a long run's output then reaches the disk behind
+ * the run, not all in the final fsync, and dirty memory stays bounded. */
+void bk_output_write_behind(int fd);
 
 #endif

@@ -612,30 +612,30 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
     return hi == eb->t_stop ? BK_STEP_STOP : BK_STEP_OK;
 }
 
-static int outside(const exact_backend *eb, double t, bk_error *err)
+/* The state at t: exact everywhere; for an output row (rows = 1) every cluster in O(its
+ * size), else by the modal sum events and merges continue from. */
+static int dense_state(void *mem, double t, double *y, int rows, bk_error *err)
 {
-    return BK_FAIL(err, BK_ERR_SOLVER,
-                   "exact stepper: t = %.17g s is outside the solution [%.17g, %.17g] s", t, eb->t0,
-                   eb->t_stop);
+    exact_backend *eb = mem;
+    if (!(t >= eb->t0 && t <= eb->t_stop))
+        return BK_FAIL(err, BK_ERR_SOLVER,
+                       "exact stepper: t = %.17g s is outside the solution [%.17g, %.17g] s", t,
+                       eb->t0, eb->t_stop);
+    if (rows)
+        bk_exact_row_state(eb, t, y);
+    else
+        bk_exact_state(eb, t, y);
+    return BK_OK;
 }
 
 static int interpolate(void *mem, double t, double *y, bk_error *err)
 {
-    exact_backend *eb = mem;
-    if (!(t >= eb->t0 && t <= eb->t_stop))
-        return outside(eb, t, err);
-    bk_exact_state(eb, t, y);
-    return BK_OK;
+    return dense_state(mem, t, y, 0, err);
 }
 
-/* Output rows: exact like interpolate's, every cluster in O(its size). */
 static int sample(void *mem, double t, double *y, bk_error *err)
 {
-    exact_backend *eb = mem;
-    if (!(t >= eb->t0 && t <= eb->t_stop))
-        return outside(eb, t, err);
-    bk_exact_row_state(eb, t, y);
-    return BK_OK;
+    return dense_state(mem, t, y, 1, err);
 }
 
 static void last_step(void *mem, double *t_lo, double *t_hi)
