@@ -350,7 +350,6 @@ done:
     return rc;
 }
 
-/* Series i's buffered rows to its dataset. */
 /* bytes more reached the page cache: past WRITE_BEHIND_BYTES, the disk starts on them. */
 static void appended(bk_h5_writer *w, size_t bytes)
 {
@@ -364,6 +363,7 @@ static void appended(bk_h5_writer *w, size_t bytes)
         bk_output_write_behind(w->part_fd);
 }
 
+/* Series i's buffered rows to its dataset. */
 static int append_series(bk_h5_writer *w, int i, bk_error *err)
 {
     bk_h5_series *s = &w->s[i];
