@@ -144,7 +144,7 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->local = s->indices + p + 1;
     eb->parent = s->indices + 2 * (p + 1);
 
-    size_t need = 3 * n + 19 * p + 4 * m * p + 2 * m + 2;
+    size_t need = 2 * n + 21 * p + 4 * m * p + 2 * m + 2;
     double *arena = bk_fit_buffer(eb->arena, &eb->arena_cap, need, sizeof *arena);
     if (!arena)
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu components", n);
@@ -166,7 +166,7 @@ static int reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roo
     eb->accel_rate = a, a += p;
     eb->row_sum = a, a += p;
     eb->row_scale = a, a += p;
-    eb->yc = a, a += n;
+    eb->yc = a, a += 2 * p;
     eb->even = a, a += p;
     eb->odd = a, a += p;
     eb->next_even = a, a += p;

@@ -99,8 +99,8 @@ typedef struct exact_backend {
     double *cluster_omega;      /* per cluster: its largest angular frequency */
     size_t *row_start, *row_col;/* p + 1; one per coupling of those clusters */
     double *row_value;
-    size_t row_cap;             /* capacity of row_col and row_value */
-    double *yc, tc;             /* n: the state at the last step end, and its time */
+    size_t row_col_cap, row_value_cap;
+    double *yc, tc;             /* 2 p: the pairs at the last step end, and its time */
     double *even, *odd, *next_even, *next_odd; /* p each */
 
     /* Root functions. */

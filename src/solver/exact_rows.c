@@ -21,7 +21,7 @@
 
 /* Below this many pairs a cluster's modal sum (2 size^2 products) is cheaper than the series
  * (about 14 sparse products of 3 entries per pair plus its sums): bench/exact_rows.c
- * measured them equal at 64 pairs, the series 1.7x faster at 128 and 28x at 2048. */
+ * measured them equal at 64 pairs, the series 1.7x faster at 128 and about 30x at 2048. */
 #define SERIES_MIN_PAIRS 64
 #define SERIES_MAX_TERMS 64
 #define SERIES_REST 0x1p-60
@@ -32,12 +32,14 @@ int bk_exact_rows_prepare(exact_backend *eb, bk_error *err)
     size_t entries = 0;
     for (size_t cl = 0; cl < eb->n_clusters; ++cl) {
         size_t first = eb->first[cl], size = eb->first[cl + 1] - first;
+        eb->series[cl] = !eb->uniform[cl] && size >= SERIES_MIN_PAIRS;
+        if (!eb->series[cl])
+            continue;
+        eb->n_series++;
         double omega = 0.0;
         for (size_t k = first; k < first + size; ++k)
             omega = fmax(omega, eb->omega[k]);
         eb->cluster_omega[cl] = omega;
-        eb->series[cl] = !eb->uniform[cl] && size >= SERIES_MIN_PAIRS;
-        eb->n_series += eb->series[cl];
     }
     if (eb->n_series == 0)
         return BK_OK;
@@ -54,19 +56,14 @@ int bk_exact_rows_prepare(exact_backend *eb, bk_error *err)
     }
     for (size_t i = 0; i < p; ++i)
         start[i + 1] += start[i];
-    if (entries > eb->row_cap || !eb->row_col) {
-        size_t cap = entries > 0 ? entries : 1;
-        size_t *col = realloc(eb->row_col, cap * sizeof *col);
-        if (col)
-            eb->row_col = col;
-        double *value = col ? realloc(eb->row_value, cap * sizeof *value) : NULL;
-        if (!value)
-            return BK_FAIL(err, BK_ERR_NOMEM,
-                           "exact stepper: out of memory for the %zu couplings of the rows' series",
-                           entries);
-        eb->row_value = value;
-        eb->row_cap = cap;
-    }
+    size_t *col = bk_fit_buffer(eb->row_col, &eb->row_col_cap, entries + 1, sizeof *col);
+    if (col)
+        eb->row_col = col;
+    double *value = col ? bk_fit_buffer(eb->row_value, &eb->row_value_cap, entries + 1, sizeof *value) : NULL;
+    if (!value)
+        return BK_FAIL(err, BK_ERR_NOMEM,
+                       "exact stepper: out of memory for the %zu couplings of the rows' series", entries);
+    eb->row_value = value;
     /* Fill row by row; start[i] walks forward and is restored from start[i + 1] after. */
     for (size_t e = 0; e < eb->n_couplings; ++e) {
         size_t i = couplings[e].row;
@@ -82,8 +79,8 @@ int bk_exact_rows_prepare(exact_backend *eb, bk_error *err)
     return BK_OK;
 }
 
-/* (K w)_i for the members of one cluster. */
-static void stiffness_times(const exact_backend *eb, const size_t *members, size_t size,
+/* -(K w)_i for the members of one cluster: d_{n+2} from d_n. */
+static void minus_stiffness_times(const exact_backend *eb, const size_t *members, size_t size,
                             const double *w, double *out)
 {
     for (size_t r = 0; r < size; ++r) {
@@ -91,7 +88,7 @@ static void stiffness_times(const exact_backend *eb, const size_t *members, size
         double sum = 0.0;
         for (size_t e = eb->row_start[i]; e < eb->row_start[i + 1]; ++e)
             sum += eb->row_value[e] * w[eb->row_col[e]];
-        out[i] = sum;
+        out[i] = -sum;
     }
 }
 
@@ -111,14 +108,14 @@ static int series_state(exact_backend *eb, size_t cl, double s, double *y)
         next_even[i] = yc[2 * i] - y0[2 * i];
         next_odd[i] = yc[2 * i + 1];
     }
-    stiffness_times(eb, members, size, next_even, even);
-    stiffness_times(eb, members, size, next_odd, odd);
+    minus_stiffness_times(eb, members, size, next_even, even);
+    minus_stiffness_times(eb, members, size, next_odd, odd);
     double tau_c = eb->tc - eb->t0;
     double f2 = 0.5 * s * s, f3 = f2 * s / 3.0; /* s^n / n! */
     for (size_t r = 0; r < size; ++r) {
         size_t i = members[r];
-        even[i] = eb->accel0[i] + eb->accel_rate[i] * tau_c - even[i];
-        odd[i] = eb->accel_rate[i] - odd[i];
+        even[i] += eb->accel0[i] + eb->accel_rate[i] * tau_c;
+        odd[i] += eb->accel_rate[i];
         /* The tails (terms n >= 2) first, so that the small terms add up among themselves. */
         y[2 * i] = even[i] * f2 + odd[i] * f3;
         y[2 * i + 1] = even[i] * s + odd[i] * f2;
@@ -126,13 +123,11 @@ static int series_state(exact_backend *eb, size_t cl, double s, double *y)
     /* Rest after the terms up to n + 1, relative to the leading one: 2 rho^n / (n + 2)!. */
     double fn1 = f3, rest = rho * rho / 12.0; /* fn1 = s^(n+1) / (n+1)! */
     for (int n = 2; rest > SERIES_REST && n + 3 < SERIES_MAX_TERMS; n += 2) {
-        stiffness_times(eb, members, size, even, next_even);
-        stiffness_times(eb, members, size, odd, next_odd);
+        minus_stiffness_times(eb, members, size, even, next_even);
+        minus_stiffness_times(eb, members, size, odd, next_odd);
         double fa = fn1 * s / (double)(n + 2), fb = fa * s / (double)(n + 3);
         for (size_t r = 0; r < size; ++r) {
             size_t i = members[r];
-            next_even[i] = -next_even[i];
-            next_odd[i] = -next_odd[i];
             y[2 * i] += next_even[i] * fa + next_odd[i] * fb;
             y[2 * i + 1] += next_even[i] * fn1 + next_odd[i] * fa;
         }
