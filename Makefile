@@ -27,7 +27,7 @@ TEST_SUPPORT := $(wildcard tests/support/*.c)
 objs = $(patsubst %.c,$(1)/%.o,$(2))
 
 .SECONDARY:
-.PHONY: all test test-plain test-asan test-valgrind lint clean paper bench install fuzz fuzz-replay
+.PHONY: all test test-plain test-asan test-valgrind test-slurm lint clean paper bench install fuzz fuzz-replay
 all: bksim
 
 build/libbksim.a: $(call objs,build,$(LIB_SRC))
@@ -74,6 +74,10 @@ test-asan: build-asan/bksim build/bench/bksim_bench build/bench/h5_plain build/b
 test-valgrind: bksim $(TESTS)
 	@BK_TEST_TIME_SCALE=200 VALGRIND="valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible --show-leak-kinds=definite,indirect,possible" \
 	 scripts/run_tests.sh valgrind $(TESTS)
+
+# The sweep's SLURM job array on a single-node cluster the script starts (root; CI runs it).
+test-slurm: bksim
+	scripts/test_slurm.sh
 
 # Static analysis (options and suppressions in tests/cppcheck.cfg), then the library's
 # namespace: every symbol libbksim.a exports starts with bk_.

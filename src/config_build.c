@@ -422,6 +422,7 @@ bk_config *bk_config_build(loader *ld)
              bk_solver_arkode_table((size_t)value_of(ld, "solver", "arkode_table")));
     check_method_fits(ld, c);
     c->wall_time_limit = value_of(ld, "run", "wall_time_limit");
+    c->seed = (unsigned long)value_of(ld, "model", "seed");
 
     bk_output_options *o = &c->output;
     entry *path = bk_config_lookup(ld, "output", "path");

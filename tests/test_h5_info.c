@@ -34,6 +34,8 @@ static void test_info(void **state)
     static const char *const needles[] = {
         "config name  tests/run.ini\n",
         "version      " BKSIM_VERSION "\n",
+        "host         ", /* where the run was made, and its seed: a point can be rerun */
+        "seed         0\n",
         "complete     1\n",
         "t_end        0.2 s\n",
         "t_reached    0.2 s\n",

@@ -83,6 +83,7 @@ typedef struct bk_config {
     bk_output_options output;
     bk_catalog_options catalog;
     double t_end;             /* s, > 0 */
+    unsigned long seed;       /* [model] seed of the numbers drawn at load time */
     double wall_time_limit;   /* s of wall-clock time before the run stops with an error;
                                  0 = no limit (default) */
     char *source_name;        /* config file path (or the name given to load_string), owned */

@@ -8,6 +8,7 @@
 #include <stdio.h>
 
 #include "bksim/run.h"
+#include "bksim/stats.h"
 #include "bksim/status.h"
 
 /* Summary of an output file: parameters, stick/slip phase counts, solver stats, and the
@@ -49,5 +50,21 @@ int bk_h5_read_transitions(const char *path, bk_transition **rows, size_t *count
                            bk_error *err);
 /* Read /events (a catalog written by bksim: every bk_event field); *rows malloc'ed. */
 int bk_h5_read_events(const char *path, bk_event **rows, size_t *count, bk_error *err);
+
+/* `bksim summary DIR`: one row per finished run (complete *.h5) in dir, sorted by file name:
+ * file, point (the sweep's grid point), one column per --set key any run used (named by the
+ * key, holding that run's value), then its headline figures: events (complete, starting in
+ * [opt->t_from, opt->t_to)), mean_recurrence (s, between their starts), largest_magnitude
+ * and largest_event_blocks, peak_slip_rate (m/s: the catalog's largest, else the largest |v|
+ * of /v), b_value, b_error, mc and b_events (as `bksim stats` with opt gives them),
+ * energy_residual, steps, rhs_evals, transitions, t_reached, wall_time, cpu_time, seed,
+ * method and host; NaN where a run has no such figure.  Written as dir/summary.tsv (a '#'
+ * line with the units, a header of column names, tab-separated rows) and dir/summary.h5
+ * (compound dataset /summary with units), each via a temporary name and a rename.  Files
+ * left out (a run that did not finish, an HDF5 file that is no bksim output, a damaged
+ * file) are named on notes (may be NULL).  *n_runs (may be NULL) gets the row count.
+ * BK_ERR_INVALID when dir holds no finished run. */
+int bk_h5_summary(const char *dir, const bk_stats_options *opt, FILE *notes, size_t *n_runs,
+                  bk_error *err);
 
 #endif

@@ -35,6 +35,8 @@ typedef struct bk_h5_writer bk_h5_writer;
  * config->output.fields selects.  On failure nothing is left on disk. */
 int bk_h5_writer_open(bk_h5_writer **out, const bk_config *config, const char *path,
                       bk_error *err);
+/* Record the name of the sweep grid point this run is (root attribute `point`). */
+int bk_h5_writer_set_point(bk_h5_writer *writer, const char *point, bk_error *err);
 /* The sink that appends to this writer. */
 bk_sink bk_h5_writer_sink(bk_h5_writer *writer);
 /* Flush, write stats, set complete = 1, close and rename "<path>.part" to <path>.

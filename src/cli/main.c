@@ -21,7 +21,7 @@ static const char *const usage_text =
     "usage: bksim <command> [options]\n"
     "\n"
     "commands:\n"
-    "  run CONFIG [-o OUT] [--set section.key=value]... [--quiet] [--force]\n"
+    "  run CONFIG [-o OUT] [--set section.key=value]... [--quiet] [--force|--resume]\n"
     "                       simulate the scene CONFIG describes, write HDF5 to OUT\n"
     "                       (default: [output] path)\n"
     "  run --restart OUT.h5[.part] [--quiet]\n"
@@ -35,13 +35,17 @@ static const char *const usage_text =
     "                       print the event catalog /events as TSV\n"
     "  stats FILE [--mc auto|VALUE] [--bin DM] [--from T] [--to T] [--json] [--tsv DIR]\n"
     "                       earthquake statistics of the catalog /events in FILE\n"
+    "  summary DIR [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
+    "                       one row per finished run in DIR (a sweep): its --set values\n"
+    "                       and headline figures, as DIR/summary.tsv and DIR/summary.h5\n"
     "  keys                 print the config key reference (Markdown)\n"
     "  --version            print the version\n"
     "\n"
     "`bksim <command> --help` describes one command.\n";
 
 static const char *const run_help =
-    "usage: bksim run CONFIG [-o OUT] [--set section.key=value]... [--quiet] [--force]\n"
+    "usage: bksim run CONFIG [-o OUT] [--set section.key=value]... [--quiet] [--force|--resume]\n"
+    "                 [--point NAME]\n"
     "       bksim run --restart OUT.h5[.part] [--quiet]\n"
     "\n"
     "Runs the scene described by the INI file CONFIG and writes an HDF5 time series.\n"
@@ -54,6 +58,9 @@ static const char *const run_help =
     "  -q, --quiet        no progress indicator and no summary\n"
     "  --force            start over even when OUT.part holds a checkpoint to restart from\n"
     "                     (without it, run refuses to overwrite that progress)\n"
+    "  --resume           continue OUT.part from its checkpoint when it holds one that\n"
+    "                     verifies, else start over: what a batch script reruns\n"
+    "  --point NAME       the sweep grid point this run is, recorded in OUT (attribute point)\n"
     "The file is written as OUT.part and renamed to OUT when the run completes; a failed\n"
     "or interrupted run leaves OUT.part marked complete = 0.\n";
 
@@ -101,6 +108,20 @@ static const char *const stats_help =
     "  --tsv DIR         also write tables for gnuplot to DIR (created if missing): mfd.tsv,\n"
     "                    gr_fit.tsv, sizes.tsv, sizes_log2.tsv, intervals.tsv,\n"
     "                    potency_ccdf.tsv\n";
+
+static const char *const summary_help =
+    "usage: bksim summary DIR [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
+    "\n"
+    "One row per finished run (complete *.h5) in DIR, sorted by file name: file, point (the\n"
+    "sweep's grid point), a column per --set key of the runs (named by the key: the run's\n"
+    "value), then events, mean_recurrence (s), largest_magnitude, largest_event_blocks,\n"
+    "peak_slip_rate (m/s), b_value, b_error, mc, b_events (as `bksim stats` gives them),\n"
+    "energy_residual, steps, rhs_evals, transitions, t_reached, wall_time, cpu_time (s),\n"
+    "seed, method, host; nan where a run has none.  Written to DIR/summary.tsv (a '#' line\n"
+    "of units, a header line, tab-separated rows: scripts/plot_summary.sh draws any column\n"
+    "against any other) and DIR/summary.h5 (compound dataset /summary).  Runs that did not\n"
+    "finish (*.h5.part) are not summarised; other files left out are named on stderr.\n"
+    "  --mc, --bin, --from, --to   as for `bksim stats`: the catalog figures use them\n";
 
 static const char *const keys_help =
     "usage: bksim keys\n"
@@ -165,8 +186,10 @@ typedef struct config_args {
     const char *output;
     const char **overrides;
     size_t n_overrides;
+    const char *point;
     int quiet;
     int force;
+    int resume;
 } config_args;
 
 static int parse_config_args(const char *command, int argc, char **argv, config_args *args)
@@ -194,6 +217,12 @@ static int parse_config_args(const char *command, int argc, char **argv, config_
             args->quiet = 1;
         } else if (allow_output && strcmp(a, "--force") == 0) {
             args->force = 1;
+        } else if (allow_output && strcmp(a, "--resume") == 0) {
+            args->resume = 1;
+        } else if (allow_output && strcmp(a, "--point") == 0) {
+            if (i + 1 >= argc || !argv[i + 1][0])
+                return usage_error(command, "%s needs a name", a);
+            args->point = argv[++i];
         } else if (allow_output && strcmp(a, "--restart") == 0) {
             if (i + 1 >= argc)
                 return usage_error(command, "%s needs the output file of the stopped run", a);
@@ -207,11 +236,14 @@ static int parse_config_args(const char *command, int argc, char **argv, config_
         }
     }
     if (args->restart) {
-        if (args->config_path || args->n_overrides || args->output)
-            return usage_error(command, "%s", "--restart takes no CONFIG, -o or --set: the run continues "
-                                              "with the config stored in its file");
+        if (args->config_path || args->n_overrides || args->output || args->point || args->resume)
+            return usage_error(command, "%s", "--restart takes no CONFIG, -o, --set, --point or "
+                                              "--resume: the run continues with the config stored "
+                                              "in its file");
         return 0;
     }
+    if (args->force && args->resume)
+        return usage_error(command, "%s", "--force starts over and --resume continues: give one");
     if (!args->config_path)
         return usage_error(command, "%s", "missing CONFIG");
     return 0;
@@ -362,7 +394,34 @@ static int cmd_run(int argc, char **argv)
             free(args.overrides);
             return EXIT_RUN_FAILED;
         }
-        if (restartable == 1) {
+        if (restartable == 1 && args.resume) {
+            /* The stored config is the one the run began with; this command's must match. */
+            restart_path = malloc(strlen(path) + sizeof ".part");
+            if (restart_path)
+                sprintf(restart_path, "%s.part", path);
+            bk_config *given = config;
+            config = NULL;
+            opened = restart_path ? bk_h5_writer_resume(&writer, restart_path, &config, &checkpoint, &err)
+                                  : BK_FAIL(&err, BK_ERR_NOMEM, "bksim: out of memory");
+            if (opened == BK_OK && strcmp(given->text, config->text) != 0) {
+                /* Cut to its checkpoint, which stays: a later --restart still continues it. */
+                bk_h5_writer_abandon(writer, "a run with another config was refused its --resume", NULL);
+                bk_checkpoint_free(&checkpoint);
+                writer = NULL;
+                opened = BK_FAIL(&err, BK_ERR_INVALID,
+                                 "%s.part was started with another config (or other --set values) "
+                                 "than this command's: pass --force to start over",
+                                 path);
+            }
+            bk_config_free(given);
+            free(restart_path);
+            restart_path = bk_output_final_path(path);
+            path = restart_path;
+            args.restart = path; /* from here on, a restarted run */
+            if (!args.quiet && opened == BK_OK)
+                fprintf(stderr, "bksim: continuing %s.part from its checkpoint t = %.17g s\n", path,
+                        t_checkpoint);
+        } else if (restartable == 1) {
             fprintf(stderr,
                     "%s.part holds a run stopped at its checkpoint t = %.17g s: continue it with "
                     "`bksim run --restart %s.part`, or pass --force to start over\n",
@@ -370,8 +429,14 @@ static int cmd_run(int argc, char **argv)
             bk_config_free(config);
             free(args.overrides);
             return EXIT_USAGE;
+        } else {
+            opened = bk_h5_writer_open(&writer, config, path, &err);
+            if (opened == BK_OK && args.point && bk_h5_writer_set_point(writer, args.point, &err) != BK_OK) {
+                bk_h5_writer_abandon(writer, err.message, NULL);
+                writer = NULL;
+                opened = BK_ERR_IO;
+            }
         }
-        opened = bk_h5_writer_open(&writer, config, path, &err);
     }
     if (opened != BK_OK) {
         fprintf(stderr, "%s\n", err.message);
@@ -477,6 +542,51 @@ static int cmd_export(int argc, char **argv)
     return 0;
 }
 
+/* The catalog options of stats and summary (--mc, --bin, --from, --to) at argv[*i]:
+ * -1 when argv[*i] is none of them, 0 when taken (*i advanced past a separate value), else
+ * the exit status of a usage error.  Ranges (finite, a bin centre, ...) are
+ * bk_stats_options_check's. */
+static int parse_catalog_option(const char *command, int argc, char **argv, int *i,
+                                bk_stats_options *opt)
+{
+    static const char *const names[] = {"--mc", "--bin", "--from", "--to"};
+    const char *a = argv[*i], *value = NULL;
+    size_t which = 0;
+    for (; which < 4; ++which) {
+        size_t len = strlen(names[which]);
+        if (strcmp(a, names[which]) == 0 && *i + 1 < argc) {
+            value = argv[++*i];
+            break;
+        }
+        if (strncmp(a, names[which], len) == 0 && a[len] == '=') {
+            value = a + len + 1;
+            break;
+        }
+    }
+    if (!value)
+        return -1;
+    char *end = NULL;
+    errno = 0;
+    if (which == 0) {
+        opt->mc_auto = strcmp(value, "auto") == 0;
+        if (!opt->mc_auto) {
+            opt->mc = strtod(value, &end);
+            if (errno || end == value || *end)
+                return usage_error(command, "--mc needs 'auto' or a magnitude, got '%s'", value);
+        }
+    } else if (which == 1) {
+        opt->dm = strtod(value, &end);
+        if (errno || end == value || *end)
+            return usage_error(command, "--bin needs a bin width 0 < DM <= 10, got '%s'", value);
+    } else {
+        double t = strtod(value, &end);
+        if (errno || end == value || *end || !isfinite(t))
+            return usage_error(command, "%s needs a time in s, got '%s'", names[which], value);
+        *(which == 2 ? &opt->t_from : &opt->t_to) = t;
+    }
+    return 0;
+}
+
 static int cmd_stats(int argc, char **argv)
 {
     if (wants_help(argc, argv)) {
@@ -489,40 +599,15 @@ static int cmd_stats(int argc, char **argv)
     int json = 0;
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
-        const char *value = NULL;
-        if ((strcmp(a, "--mc") == 0 || strcmp(a, "--bin") == 0 || strcmp(a, "--tsv") == 0 ||
-             strcmp(a, "--from") == 0 || strcmp(a, "--to") == 0) &&
-            i + 1 < argc)
-            value = argv[++i];
-        else if (strncmp(a, "--mc=", 5) == 0 || strncmp(a, "--bin=", 6) == 0 ||
-                 strncmp(a, "--tsv=", 6) == 0 || strncmp(a, "--from=", 7) == 0 ||
-                 strncmp(a, "--to=", 5) == 0)
-            value = strchr(a, '=') + 1;
-        /* Ranges (finite, a bin centre, ...) are bk_stats_options_check's. */
-        char *end = NULL;
-        errno = 0;
-        if (value && strncmp(a, "--mc", 4) == 0) {
-            opt.mc_auto = strcmp(value, "auto") == 0;
-            if (!opt.mc_auto) {
-                opt.mc = strtod(value, &end);
-                if (errno || end == value || *end)
-                    return usage_error("stats", "--mc needs 'auto' or a magnitude, got '%s'",
-                                       value);
-            }
-        } else if (value && strncmp(a, "--bin", 5) == 0) {
-            opt.dm = strtod(value, &end);
-            if (errno || end == value || *end)
-                return usage_error("stats", "--bin needs a bin width 0 < DM <= 10, got '%s'",
-                                   value);
-        } else if (value && (strncmp(a, "--from", 6) == 0 || strncmp(a, "--to", 4) == 0)) {
-            int from = strncmp(a, "--from", 6) == 0;
-            double t = strtod(value, &end);
-            if (errno || end == value || *end || !isfinite(t))
-                return usage_error("stats", "%s needs a time in s, got '%s'", from ? "--from" : "--to",
-                                   value);
-            *(from ? &opt.t_from : &opt.t_to) = t;
-        } else if (value) {
-            tsv_dir = value;
+        int taken = parse_catalog_option("stats", argc, argv, &i, &opt);
+        if (taken > 0)
+            return taken;
+        if (taken == 0)
+            continue;
+        if (strcmp(a, "--tsv") == 0 && i + 1 < argc) {
+            tsv_dir = argv[++i];
+        } else if (strncmp(a, "--tsv=", 6) == 0) {
+            tsv_dir = a + 6;
         } else if (strcmp(a, "--json") == 0) {
             json = 1;
         } else if (a[0] == '-') {
@@ -554,6 +639,41 @@ static int cmd_stats(int argc, char **argv)
     return 0;
 }
 
+static int cmd_summary(int argc, char **argv)
+{
+    if (wants_help(argc, argv)) {
+        fputs(summary_help, stdout);
+        return 0;
+    }
+    bk_stats_options opt;
+    bk_stats_options_default(&opt);
+    const char *dir = NULL;
+    for (int i = 0; i < argc; ++i) {
+        int taken = parse_catalog_option("summary", argc, argv, &i, &opt);
+        if (taken > 0)
+            return taken;
+        if (taken == 0)
+            continue;
+        if (argv[i][0] == '-')
+            return usage_error("summary", "unknown or incomplete option '%s'", argv[i]);
+        if (dir)
+            return usage_error("summary", "unexpected argument '%s'", argv[i]);
+        dir = argv[i];
+    }
+    if (!dir)
+        return usage_error("summary", "%s", "missing DIR");
+    bk_error err = {0};
+    if (bk_stats_options_check(&opt, &err) != BK_OK)
+        return usage_error("summary", "%s", err.message);
+    size_t runs = 0;
+    if (bk_h5_summary(dir, &opt, stderr, &runs, &err) != BK_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return EXIT_RUN_FAILED;
+    }
+    printf("%s/summary.tsv, %s/summary.h5: %zu run%s\n", dir, dir, runs, runs == 1 ? "" : "s");
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -573,6 +693,8 @@ int main(int argc, char **argv)
         return cmd_export(rest, rest_argv);
     if (strcmp(command, "stats") == 0)
         return cmd_stats(rest, rest_argv);
+    if (strcmp(command, "summary") == 0)
+        return cmd_summary(rest, rest_argv);
     if (strcmp(command, "keys") == 0) {
         if (wants_help(rest, rest_argv)) {
             fputs(keys_help, stdout);

@@ -191,6 +191,11 @@ int bk_h5_info(const char *path, FILE *out, bk_error *err)
     char *version = bk_h5_read_string_attr(file, "version");
     char *config = bk_h5_read_string_attr(file, "config");
     char *error = bk_h5_read_string_attr(file, "error");
+    char *host = bk_h5_read_string_attr(file, "host");
+    char *point = bk_h5_read_string_attr(file, "point");
+    long long seed = -1;
+    int have_seed = H5Aexists(file, "seed") > 0 &&
+                    bk_h5_read_numeric_attr(file, "seed", H5T_NATIVE_LLONG, &seed) >= 0;
     int complete = 0;
     double t_end = NAN, t_reached = NAN;
     int have_complete = bk_h5_read_numeric_attr(file, "complete", H5T_NATIVE_INT, &complete) >= 0;
@@ -207,6 +212,12 @@ int bk_h5_info(const char *path, FILE *out, bk_error *err)
     fprintf(out, "file         %s\n", path);
     fprintf(out, "config name  %s\n", name ? name : "?");
     fprintf(out, "version      %s\n", version ? version : "?");
+    if (host)
+        fprintf(out, "host         %s\n", host);
+    if (have_seed)
+        fprintf(out, "seed         %lld\n", seed);
+    if (point)
+        fprintf(out, "point        %s\n", point);
     if (have_complete)
         fprintf(out, "complete     %d%s\n", complete, complete ? "" : " (run did not finish)");
     else
@@ -257,6 +268,8 @@ int bk_h5_info(const char *path, FILE *out, bk_error *err)
     free(version);
     free(config);
     free(error);
+    free(host);
+    free(point);
     free(stick);
     free(slip);
     bk_h5_close_id(file);

@@ -112,6 +112,13 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
         bk_h5_write_double_attr(w->file, "t_reached", 0.0) < 0 ||
         bk_h5_write_string_attr(w->file, "attribute_units", "t_end: s, t_reached: s") < 0)
         return H5_FAIL(err, "%s: cannot write root attributes", w->part);
+    /* Where and from which numbers a run came, so that one point of a sweep can be rerun. */
+    char host[256] = "";
+    if (gethostname(host, sizeof host - 1) != 0)
+        snprintf(host, sizeof host, "unknown");
+    if (bk_h5_write_string_attr(w->file, "host", host) < 0 ||
+        bk_h5_write_long_attr(w->file, "seed", (long long)config->seed) < 0)
+        return H5_FAIL(err, "%s: cannot write root attributes", w->part);
     /* What a restart needs to load the same config again: the file as read and the --set
      * overrides (the `config` attribute shows them only as comments). */
     size_t len = 1;
@@ -323,6 +330,16 @@ int bk_h5_writer_open(bk_h5_writer **out, const bk_config *config, const char *p
         return rc;
     }
     *out = w;
+    return BK_OK;
+}
+
+int bk_h5_writer_set_point(bk_h5_writer *writer, const char *point, bk_error *err)
+{
+    if (!writer || !point || !*point)
+        return BK_FAIL(err, BK_ERR_INVALID, "bk_h5_writer_set_point: needs a writer and a non-empty name");
+    /* Fixed-length: written after the file was created (see bk_h5_write_fixed_string_attr). */
+    if (bk_h5_write_fixed_string_attr(writer->file, "point", point) < 0)
+        return H5_FAIL(err, "%s: cannot write the root attribute point", writer->part);
     return BK_OK;
 }
 

@@ -1,0 +1,224 @@
+/* bk_h5_summary (`bksim summary DIR`): the figures of each run against the single block's
+ * closed form, the columns of the TSV and of the HDF5 table, and what is left out.  Runs
+ * ./bksim from the repository root to make the outputs. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <hdf5.h>
+
+#include "bk_test.h"
+#include "bksim/bksim.h"
+#include "command.h"
+#include "files.h"
+#include "h5_raw.h"
+
+static char tmpdir[256];
+
+static int setup(void **state)
+{
+    (void)state;
+    return make_temp_dir(tmpdir, sizeof tmpdir, "bksim_summary");
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    return remove_tree(tmpdir);
+}
+
+/* Case A's block (m = 1 kg, k = 1e4 N/m, N = 9.81 N, mu_s = 0.6, V = 1 mm/s) under Coulomb
+ * friction: a stick of 2 (mu_s - mu_d) N / (k V), then a slip of (2 pi - 2 atan(A w / V)) / w
+ * with A = (mu_s - mu_d) N / k, w = sqrt(k / m), whose fastest speed is V + sqrt((A w)^2 + V^2). */
+static void closed_form(double mu_d, double *period, double *peak)
+{
+    const double k = 1e4, n = 9.81, v = 1e-3, w = 100.0, a = (0.6 - mu_d) * n / k;
+    *period = 2.0 * (0.6 - mu_d) * n / (k * v) + (4.0 * acos(0.0) - 2.0 * atan(a * w / v)) / w;
+    *peak = v + sqrt(a * w * a * w + v * v);
+}
+
+/* The whitespace-free field `column` (0-based) of the line of `path` that starts with
+ * `first`, tab-separated; static buffer. */
+static const char *tsv_field(const char *path, const char *first, int column)
+{
+    static char line[8192];
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    const char *found = NULL;
+    while (!found && fgets(line, sizeof line, f))
+        if (strncmp(line, first, strlen(first)) == 0 && line[strlen(first)] == '\t')
+            found = line;
+    fclose(f);
+    assert_non_null(found);
+    char *save = NULL, *field = strtok_r(line, "\t\n", &save);
+    for (int c = 0; c < column && field; ++c)
+        field = strtok_r(NULL, "\t\n", &save);
+    assert_non_null(field);
+    return field;
+}
+
+static int header_column(const char *path, const char *name)
+{
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    char line[8192];
+    int column = -1;
+    while (fgets(line, sizeof line, f))
+        if (strncmp(line, "file\t", 5) == 0) {
+            char *save = NULL;
+            int c = 0;
+            for (char *field = strtok_r(line, "\t\n", &save); field; field = strtok_r(NULL, "\t\n", &save), ++c)
+                if (strcmp(field, name) == 0)
+                    column = c;
+        }
+    fclose(f);
+    return column;
+}
+
+static double tsv_number(const char *path, const char *file, const char *name)
+{
+    int column = header_column(path, name);
+    assert_true(column >= 0);
+    return strtod(tsv_field(path, file, column), NULL);
+}
+
+static void test_figures_and_columns(void **state)
+{
+    (void)state;
+    char dir[300], cmd[4096];
+    snprintf(dir, sizeof dir, "%s/runs", tmpdir);
+    const double mu_d[2] = {0.1, 0.3};
+    for (int k = 0; k < 2; ++k) {
+        snprintf(cmd, sizeof cmd,
+                 "./bksim run configs/paper/case_a_coulomb.ini -q -o %s/mu_%d.h5 --point p%d "
+                 "--set friction.mu_d=%g --set run.t_end=8%s",
+                 dir, k, k, mu_d[k], k ? " --set solver.method=exact" : "");
+        assert_int_equal(run_command(cmd, NULL), 0);
+    }
+    /* Left out: a run that did not finish, an HDF5 file of another program, not HDF5 at all. */
+    snprintf(cmd, sizeof cmd,
+             "./bksim run configs/paper/case_a_coulomb.ini -q -o %s/stopped.h5 --set run.t_end=1e4 "
+             "--set output.interval=0 --set run.wall_time_limit=0.01; "
+             "cp %s/mu_0.h5 %s/other.h5 && h5ls %s/other.h5 > /dev/null && echo text > %s/text.h5",
+             dir, dir, dir, dir, dir);
+    run_command(cmd, NULL);
+    char other_path[600];
+    snprintf(other_path, sizeof other_path, "%s/other.h5", dir);
+    hid_t other = H5Fopen(other_path, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(other >= 0);
+    assert_true(H5Adelete(other, "version") >= 0);
+    H5Fclose(other);
+
+    char notes_path[600];
+    snprintf(notes_path, sizeof notes_path, "%s/notes.txt", tmpdir);
+    FILE *notes = fopen(notes_path, "w");
+    assert_non_null(notes);
+    bk_stats_options opt;
+    bk_stats_options_default(&opt);
+    bk_error err = {0};
+    size_t runs = 0;
+    int rc = bk_h5_summary(dir, &opt, notes, &runs, &err);
+    fclose(notes);
+    if (rc != BK_OK)
+        print_message("%s\n", err.message);
+    assert_int_equal(rc, BK_OK);
+    assert_int_equal(runs, 2);
+    char *text = NULL;
+    snprintf(cmd, sizeof cmd, "cat %s", notes_path);
+    run_command(cmd, &text);
+    assert_non_null(strstr(text, "other.h5: not a bksim output"));
+    assert_non_null(strstr(text, "text.h5: not an HDF5 file"));
+    assert_null(strstr(text, "stopped")); /* stopped.h5.part is no *.h5 */
+    free(text);
+
+    char tsv[600];
+    snprintf(tsv, sizeof tsv, "%s/summary.tsv", dir);
+    for (int k = 0; k < 2; ++k) {
+        char file[32];
+        snprintf(file, sizeof file, "mu_%d.h5", k);
+        double period, peak;
+        closed_form(mu_d[k], &period, &peak);
+        assert_close(tsv_number(tsv, file, "friction.mu_d"), mu_d[k], 0.0, 0.0);
+        /* %.12g in the table: the closed form to 12 digits. */
+        assert_close(tsv_number(tsv, file, "mean_recurrence"), period, 0.0, 2e-11 * period);
+        assert_close(tsv_number(tsv, file, "peak_slip_rate"), peak, 0.0, 2e-11 * peak);
+        assert_close(tsv_number(tsv, file, "run.t_end"), 8.0, 0.0, 0.0);
+        assert_close(tsv_number(tsv, file, "t_reached"), 8.0, 0.0, 0.0);
+        assert_close(tsv_number(tsv, file, "largest_event_blocks"), 1.0, 0.0, 0.0);
+        assert_close(tsv_number(tsv, file, "seed"), 1.0, 0.0, 0.0);
+        /* All events of one block are alike: no b-value. */
+        assert_true(isnan(tsv_number(tsv, file, "b_value")));
+        assert_string_equal(tsv_field(tsv, file, header_column(tsv, "point")), k ? "p1" : "p0");
+    }
+    /* A text key: set in one run only; "-" where a run did not set it. */
+    assert_string_equal(tsv_field(tsv, "mu_0.h5", header_column(tsv, "solver.method")), "-");
+    assert_string_equal(tsv_field(tsv, "mu_1.h5", header_column(tsv, "solver.method")), "exact");
+    assert_string_equal(tsv_field(tsv, "mu_1.h5", header_column(tsv, "method")), "exact");
+
+    /* The HDF5 table: the same rows, numeric key columns as doubles, units per column. */
+    char h5[600];
+    snprintf(h5, sizeof h5, "%s/summary.h5", dir);
+    hid_t file = H5Fopen(h5, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(file >= 0);
+    hid_t dset = H5Dopen2(file, "summary", H5P_DEFAULT);
+    assert_true(dset >= 0);
+    char *units = attr_string(dset, "units");
+    assert_non_null(strstr(units, "friction.mu_d: 1"));
+    assert_non_null(strstr(units, "mean_recurrence: s"));
+    assert_non_null(strstr(units, "peak_slip_rate: m/s"));
+    free(units);
+    hid_t mem = H5Tcreate(H5T_COMPOUND, 2 * sizeof(double));
+    H5Tinsert(mem, "friction.mu_d", 0, H5T_NATIVE_DOUBLE);
+    H5Tinsert(mem, "mean_recurrence", sizeof(double), H5T_NATIVE_DOUBLE);
+    double rows[2][2];
+    assert_true(H5Dread(dset, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows) >= 0);
+    for (int k = 0; k < 2; ++k) {
+        double period, peak;
+        closed_form(mu_d[k], &period, &peak);
+        assert_close(rows[k][0], mu_d[k], 0.0, 0.0);
+        assert_close(rows[k][1], period, 0.0, 1e-12 * period);
+    }
+    H5Tclose(mem);
+    H5Dclose(dset);
+    H5Fclose(file);
+}
+
+static void test_nothing_to_summarise(void **state)
+{
+    (void)state;
+    char dir[512];
+    snprintf(dir, sizeof dir, "%s/empty", tmpdir);
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "mkdir -p %s", dir);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    bk_stats_options opt;
+    bk_stats_options_default(&opt);
+    bk_error err = {0};
+    assert_int_equal(bk_h5_summary(dir, &opt, NULL, NULL, &err), BK_ERR_INVALID);
+    assert_non_null(strstr(err.message, "no finished bksim output"));
+    char path[600];
+    snprintf(path, sizeof path, "%s/summary.tsv", dir);
+    assert_false(path_exists(path));
+    snprintf(path, sizeof path, "%s/none", tmpdir);
+    assert_int_equal(bk_h5_summary(path, &opt, NULL, NULL, &err), BK_ERR_IO);
+    assert_non_null(strstr(err.message, "cannot read the directory"));
+    /* The command line: exit 1 with the message; bad options exit 2. */
+    snprintf(cmd, sizeof cmd, "./bksim summary %s", dir);
+    expect_command(cmd, 1, "no finished bksim output");
+    expect_command("./bksim summary", 2, "missing DIR");
+    snprintf(cmd, sizeof cmd, "./bksim summary %s --bin 0", dir);
+    expect_command(cmd, 2, "magnitude bin width 0");
+    snprintf(cmd, sizeof cmd, "./bksim summary %s --from x", dir);
+    expect_command(cmd, 2, "--from needs a time");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_figures_and_columns),
+        cmocka_unit_test(test_nothing_to_summarise),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
