@@ -97,6 +97,11 @@ static void test_figures_and_columns(void **state)
                  dir, k, k, mu_d[k], k ? " --set solver.method=exact" : "");
         assert_int_equal(run_command(cmd, NULL), 0);
     }
+    /* Without a catalog: the peak slip rate from /v, sampled every 0.1 ms. */
+    snprintf(cmd, sizeof cmd,
+             "./bksim run configs/paper/case_a_coulomb.ini -q -o %s/mu_2.h5 --set friction.mu_d=0.1 "
+             "--set run.t_end=8 --set output.events=false", dir);
+    assert_int_equal(run_command(cmd, NULL), 0);
     /* Left out: a run that did not finish, an HDF5 file of another program, not HDF5 at all. */
     snprintf(cmd, sizeof cmd,
              "./bksim run configs/paper/case_a_coulomb.ini -q -o %s/stopped.h5 --set run.t_end=1e4 "
@@ -124,7 +129,7 @@ static void test_figures_and_columns(void **state)
     if (rc != BK_OK)
         print_message("%s\n", err.message);
     assert_int_equal(rc, BK_OK);
-    assert_int_equal(runs, 2);
+    assert_int_equal(runs, 3);
     char *text = NULL;
     snprintf(cmd, sizeof cmd, "cat %s", notes_path);
     run_command(cmd, &text);
@@ -152,6 +157,12 @@ static void test_figures_and_columns(void **state)
         assert_true(isnan(tsv_number(tsv, file, "b_value")));
         assert_string_equal(tsv_field(tsv, file, header_column(tsv, "point")), k ? "p1" : "p0");
     }
+    double period_0, peak_0;
+    closed_form(0.1, &period_0, &peak_0);
+    double sampled = tsv_number(tsv, "mu_2.h5", "peak_slip_rate");
+    assert_true(sampled <= peak_0 * (1.0 + 1e-12) && sampled >= 0.999 * peak_0);
+    assert_true(isnan(tsv_number(tsv, "mu_2.h5", "events")));
+    assert_true(isnan(tsv_number(tsv, "mu_2.h5", "mean_recurrence")));
     /* A text key: set in one run only; "-" where a run did not set it. */
     assert_string_equal(tsv_field(tsv, "mu_0.h5", header_column(tsv, "solver.method")), "-");
     assert_string_equal(tsv_field(tsv, "mu_1.h5", header_column(tsv, "solver.method")), "exact");
@@ -172,7 +183,7 @@ static void test_figures_and_columns(void **state)
     hid_t mem = H5Tcreate(H5T_COMPOUND, 2 * sizeof(double));
     H5Tinsert(mem, "friction.mu_d", 0, H5T_NATIVE_DOUBLE);
     H5Tinsert(mem, "mean_recurrence", sizeof(double), H5T_NATIVE_DOUBLE);
-    double rows[2][2];
+    double rows[3][2];
     assert_true(H5Dread(dset, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows) >= 0);
     for (int k = 0; k < 2; ++k) {
         double period, peak;

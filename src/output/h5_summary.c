@@ -204,21 +204,35 @@ static int catalog_figures(const char *path, const bk_stats_options *opt, run_ro
     return BK_OK;
 }
 
-/* Without a catalog the peak slip rate is the time series' largest |v|. */
-static int series_peak_slip_rate(const char *path, run_row *run, bk_error *err)
+/* Without a catalog the peak slip rate is the time series' largest |v|, read a slab of
+ * rows at a time (a long chain's /v need not fit in memory). */
+static int series_peak_slip_rate(hid_t file, const char *path, run_row *run, bk_error *err)
 {
-    double *v = NULL;
-    size_t rows = 0, cols = 0;
-    int rc = bk_h5_read_doubles(path, "v", &v, &rows, &cols, err);
+    hid_t dset = H5I_INVALID_HID;
+    hsize_t rows = 0, cols = 0;
+    int rank = 0;
+    int rc = bk_h5_open_series(file, path, "v", &dset, &rows, &cols, &rank, err);
     if (rc != BK_OK)
         return rc;
+    hsize_t slab = cols >= 65536 ? 1 : 65536 / (cols ? cols : 1);
+    double *v = malloc((size_t)(slab * cols) * sizeof *v);
+    if (!v)
+        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for /v", path);
     double peak = NAN;
-    for (size_t i = 0; i < rows * cols; ++i)
-        if (!(fabs(v[i]) <= peak))
-            peak = fabs(v[i]);
+    for (hsize_t start = 0; rc == BK_OK && start < rows; start += slab) {
+        hsize_t count = rows - start < slab ? rows - start : slab;
+        if (bk_h5_read_block(dset, rank, start, count, 0, cols, H5T_NATIVE_DOUBLE, v) < 0) {
+            rc = H5_DAMAGED(err, "%s: cannot read /v", path);
+            break;
+        }
+        for (size_t i = 0; i < (size_t)(count * cols); ++i)
+            if (!(fabs(v[i]) <= peak))
+                peak = fabs(v[i]);
+    }
     free(v);
+    CLOSE_IDS(rc == BK_OK ? 0 : -1, dset);
     run->figure[FIG_PEAK_SLIP_RATE] = peak;
-    return BK_OK;
+    return rc;
 }
 
 /* One output file into a row.  BK_INCOMPLETE for a run that did not finish and
@@ -236,7 +250,7 @@ static int read_run(summary *s, const char *dir, const char *name, const bk_stat
     for (int f = 0; f < N_FIGURES; ++f)
         run.figure[f] = NAN;
     char *version = NULL, *overrides = NULL;
-    int has_events = 0, has_v = 0;
+    int has_events = 0;
     if (rc == BK_OK) {
         version = bk_h5_read_string_attr(file, "version");
         if (!version)
@@ -250,7 +264,8 @@ static int read_run(summary *s, const char *dir, const char *name, const bk_stat
         run.figure[FIG_SEED] = numeric_attr(file, "seed");
         overrides = bk_h5_read_string_attr(file, "overrides");
         has_events = H5Lexists(file, "events", H5P_DEFAULT) > 0;
-        has_v = H5Lexists(file, "v", H5P_DEFAULT) > 0;
+        if (!has_events && H5Lexists(file, "v", H5P_DEFAULT) > 0)
+            rc = series_peak_slip_rate(file, path, &run, err);
         if (H5Lexists(file, "stats", H5P_DEFAULT) > 0 &&
             (stats = H5Gopen2(file, "stats", H5P_DEFAULT)) >= 0) {
             for (size_t a = 0; a < sizeof stats_attrs / sizeof stats_attrs[0]; ++a)
@@ -258,15 +273,14 @@ static int read_run(summary *s, const char *dir, const char *name, const bk_stat
             run.method = bk_h5_read_string_attr(stats, "method");
         }
     }
-    CLOSE_IDS(0, stats, file);
-    if (rc == BK_OK && !(run.file = strdup(name)))
-        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
-    if (rc == BK_OK && take_overrides(s, &run, overrides) != 0)
-        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for its overrides", path);
+    CLOSE_IDS(rc == BK_OK ? 0 : -1, stats, file);
     if (rc == BK_OK && has_events)
         rc = catalog_figures(path, opt, &run, err);
-    else if (rc == BK_OK && has_v)
-        rc = series_peak_slip_rate(path, &run, err);
+    if (rc == BK_OK && !(run.file = strdup(name)))
+        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    /* Last: a run left out adds no key column. */
+    if (rc == BK_OK && take_overrides(s, &run, overrides) != 0)
+        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for its overrides", path);
     free(version);
     free(overrides);
     free(path);
