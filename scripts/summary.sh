@@ -1,15 +1,35 @@
 #!/usr/bin/env bash
-# One line per run: slip events (stick -> slip), peak slip rate and the range of the
-# apparent COF of block 0.
+# One line per run, over every block: slip events (stick -> slip transitions of any block),
+# peak slip rate (largest |v| of any block) and the range of the apparent COF (all blocks).
+# A file without /transitions, /v or /cof gets "n/a" for that figure, and the loop goes on;
+# a file that cannot be read is named on stderr, and the exit status is then 1.  For a sweep
+# directory, `bksim summary DIR` gives one table with every run's figures.
 # usage: summary.sh RUN.h5...
-set -euo pipefail
+set -uo pipefail
 bksim=${BKSIM:-./bksim}
+[ -x "$bksim" ] || bksim="$(dirname "$0")/../bksim"
+[ $# -gt 0 ] || { echo "usage: summary.sh RUN.h5..." >&2; exit 2; }
+status=0
+# The largest |value| (abs = 1) or the range of every column but none, of an export.
+columns() {
+    awk -v abs="$1" '/^#/ {next}
+        { for (i = 1; i <= NF; ++i) { x = $i; if (abs && x < 0) x = -x
+              if (n++ == 0 || x < lo) lo = x; if (n == 1 || x > hi) hi = x } }
+        END { if (!n) print "n/a"; else if (abs) printf "%.4g\n", hi; else printf "%.4g .. %.4g\n", lo, hi }'
+}
 for file in "$@"; do
-    slips=$("$bksim" export "$file" --transitions --block 0 | awk '!/^#/ && $3 == 0 && $4 != 0 {n++} END {print n+0}')
-    "$bksim" export "$file" --datasets time,v,cof --block 0 | awk -v f="$(basename "$file" .h5)" -v slips="$slips" '
-        /^#/ {next}
-        { v = $2 < 0 ? -$2 : $2; if (v > vmax) vmax = v
-          if (n++ == 0 || $3 < cmin) cmin = $3; if (n == 1 || $3 > cmax) cmax = $3 }
-        END { printf "%-32s slip events %4d   peak slip rate %.4g m/s   apparent COF %.4g .. %.4g\n",
-                     f, slips, vmax, cmin, cmax }'
+    name=$(basename "$file" .h5)
+    # 0: complete; 3: a run that did not finish, summarised as far as it got.
+    why=$("$bksim" info "$file" 2>&1 > /dev/null)
+    case $? in
+        0|3) ;;
+        *) echo "summary.sh: $(head -1 <<< "$why")" >&2; status=1; continue ;;
+    esac
+    slips=$("$bksim" export "$file" --transitions 2> /dev/null |
+        awk '!/^#/ && $3 == 0 && $4 != 0 {n++} END {print n+0}') || slips=n/a
+    vmax=$("$bksim" export "$file" --datasets v 2> /dev/null | columns 1) || vmax=n/a
+    cof=$("$bksim" export "$file" --datasets cof 2> /dev/null | columns 0) || cof=n/a
+    printf "%-32s slip events %4s   peak slip rate %s m/s   apparent COF %s\n" "$name" "$slips" \
+        "${vmax:-n/a}" "${cof:-n/a}"
 done
+exit $status

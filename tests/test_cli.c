@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <hdf5.h>
@@ -631,6 +632,157 @@ static void test_killed_run_leaves_partial(void **state)
     free(text);
 }
 
+/* While a run writes its .part: `bksim info` reports its progress (exit 3) instead of a
+ * damaged file, and a second run with the same -o, a --restart and a reader are refused
+ * with a message that names the owner, never HDF5's "Resource temporarily unavailable". */
+static void test_running_output(void **state)
+{
+    (void)state;
+    char out[512], cmd[2048];
+    snprintf(out, sizeof out, "%s/running.h5", tmpdir);
+    const char *scene = "configs/paper/case_b_coulomb.ini -q --set run.t_end=1e6 "
+                        "--set solver.method=cvode_adams --set output.checkpoint_interval=2 "
+                        "--set output.interval=0.01";
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s > /dev/null 2>&1 & echo $!", scene, out);
+    char *text = NULL;
+    assert_int_equal(run_command(cmd, &text), 0);
+    long pid = strtol(text, NULL, 10);
+    free(text);
+    assert_true(pid > 0);
+    /* Until a checkpoint has been flushed: then the progress is that checkpoint's. */
+    int status = -1;
+    double t = 0.0;
+    snprintf(cmd, sizeof cmd, "./bksim info %s.part", out);
+    for (int tries = 0; tries < 600 && !(t > 0.0); ++tries) {
+        nanosleep(&(struct timespec){0, 20000000L}, NULL);
+        status = run_command(cmd, &text);
+        const char *progress = strstr(text, "in progress, t = ");
+        if (progress)
+            t = strtod(progress + strlen("in progress, t = "), NULL);
+        if (t > 0.0) {
+            assert_int_equal(status, 3);
+            assert_non_null(strstr(text, "transitions so far"));
+            assert_non_null(strstr(text, "checkpoint   t = "));
+        }
+        free(text);
+    }
+    assert_true(t > 0.0);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s", scene, out);
+    expect_command(cmd, 1, "another run owns this file");
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --force", scene, out);
+    expect_command(cmd, 1, "another run owns this file");
+    snprintf(cmd, sizeof cmd, "./bksim run --restart %s.part", out);
+    expect_command(cmd, 1, "another run owns this file");
+    snprintf(cmd, sizeof cmd, "./bksim export %s.part --transitions", out);
+    expect_command(cmd, 1, "a run is still writing this file");
+    /* The run was not disturbed: stopped now, it leaves a .part to continue from. */
+    snprintf(cmd, sizeof cmd, "kill -TERM %ld; while kill -0 %ld 2>/dev/null; do sleep 0.02; done; "
+             "./bksim info %s.part", pid, pid, out);
+    status = run_command(cmd, &text);
+    assert_int_equal(status, 3);
+    assert_non_null(strstr(text, "did not finish"));
+    assert_null(strstr(text, "in progress"));
+    free(text);
+}
+
+/* 1,000 blocks: a summary of the phases in a few lines; the table behind --blocks. */
+static void test_info_at_chain_scale(void **state)
+{
+    (void)state;
+    char out[512], cmd[1024];
+    snprintf(out, sizeof out, "%s/chain1000.h5", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run configs/chains/bk1000_coulomb.ini -q -o %s --set run.t_end=0.5", out);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    char *text = NULL;
+    snprintf(cmd, sizeof cmd, "./bksim info %s", out);
+    assert_int_equal(run_command(cmd, &text), 0);
+    size_t lines = 0;
+    for (const char *c = text; *c; ++c)
+        lines += *c == '\n';
+    print_message("bksim info of 1,000 blocks: %zu lines\n", lines);
+    assert_true(lines < 100);
+    assert_non_null(strstr(text, "phases per block: 1000 blocks, "));
+    assert_non_null(strstr(text, "slips per block: min "));
+    assert_non_null(strstr(text, "most active: block "));
+    assert_null(strstr(text, "block 999:"));
+    free(text);
+    snprintf(cmd, sizeof cmd, "./bksim info %s --blocks", out);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_non_null(strstr(text, "    block 0: "));
+    assert_non_null(strstr(text, "    block 999: "));
+    free(text);
+    snprintf(cmd, sizeof cmd, "./bksim info %s --block", out);
+    expect_command(cmd, 2, "unknown option '--block'");
+}
+
+/* scripts/summary.sh counts every block and goes on past a file it cannot summarise. */
+static void test_summary_script(void **state)
+{
+    (void)state;
+    char two[512], bare[512], cmd[2048];
+    snprintf(two, sizeof two, "%s/two_blocks.h5", tmpdir);
+    snprintf(bare, sizeof bare, "%s/no_cof.h5", tmpdir);
+    snprintf(cmd, sizeof cmd,
+             "./bksim run configs/chains/two_block_coulomb.ini -q -o %s && "
+             "./bksim run configs/paper/case_a_coulomb.ini -q -o %s --set output.fields=x,v",
+             two, bare);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    bk_transition *rows = NULL;
+    size_t n = 0;
+    bk_error err = {0};
+    assert_int_equal(bk_h5_read_transitions(two, &rows, &n, &err), BK_OK);
+    long onsets[2] = {0, 0};
+    for (size_t k = 0; k < n; ++k)
+        onsets[rows[k].block] += rows[k].from == 0 && rows[k].to != 0;
+    free(rows);
+    assert_true(onsets[0] > 0 && onsets[1] > 0);
+    char *text = NULL;
+    snprintf(cmd, sizeof cmd, "BKSIM=./bksim scripts/summary.sh %s %s/missing.h5 %s", two, tmpdir, bare);
+    assert_int_equal(run_command(cmd, &text), 1);
+    char expected[64];
+    snprintf(expected, sizeof expected, "slip events %4ld", onsets[0] + onsets[1]);
+    assert_non_null(strstr(text, expected));
+    assert_non_null(strstr(text, "missing.h5: No such file"));
+    assert_non_null(strstr(text, "no_cof "));
+    assert_non_null(strstr(text, "apparent COF n/a"));
+    free(text);
+}
+
+/* A suspicious value draws a warning naming the key from check and run; --strict makes
+ * each an error (exit 2, nothing written). */
+static void test_warnings_and_strict(void **state)
+{
+    (void)state;
+    char out[512], cmd[1024];
+    snprintf(out, sizeof out, "%s/strict.h5", tmpdir);
+    static const struct {
+        const char *set, *needle;
+    } cases[] = {
+        {"driver.velocity=1", "[driver] velocity = 1 m/s is faster than the blocks' own slip speeds"},
+        {"output.interval=0.05", "[output] interval = 0.05 s is longer than a slip"},
+        {"solver.max_step=0.1", "[solver] max_step = 0.1 s is longer than the fastest natural period"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        snprintf(cmd, sizeof cmd, "./bksim check configs/paper/case_a_coulomb.ini --set %s", cases[k].set);
+        expect_command(cmd, 0, cases[k].needle);
+        expect_command(cmd, 0, "warning: configs/paper/case_a_coulomb.ini: ");
+        snprintf(cmd, sizeof cmd, "./bksim check configs/paper/case_a_coulomb.ini --strict --set %s",
+                 cases[k].set);
+        expect_command(cmd, 2, "error (--strict): configs/paper/case_a_coulomb.ini: ");
+        snprintf(cmd, sizeof cmd, "./bksim run configs/paper/case_a_coulomb.ini -q -o %s --strict --set %s",
+                 out, cases[k].set);
+        expect_command(cmd, 2, cases[k].needle);
+        assert_false(path_exists(out));
+        assert_false(path_exists(part_path(out)));
+    }
+    /* run warns too, and runs. */
+    snprintf(cmd, sizeof cmd, "./bksim run configs/paper/case_a_coulomb.ini -q -o %s --set run.t_end=0.5 "
+             "--set solver.max_step=0.1", out);
+    expect_command(cmd, 0, "warning: ");
+    assert_true(path_exists(out));
+    expect_command("./bksim check configs/paper/case_a_coulomb.ini --strict", 0, ": ok: ");
+}
+
 /* A damaged file is reported as such: truncated, or hand-edited inconsistent. */
 static void test_damaged_files(void **state)
 {
@@ -1021,6 +1173,10 @@ int main(void)
         cmocka_unit_test(test_progress_on_terminal),
         cmocka_unit_test(test_interrupted_run_is_marked),
         cmocka_unit_test(test_killed_run_leaves_partial),
+        cmocka_unit_test(test_running_output),
+        cmocka_unit_test(test_info_at_chain_scale),
+        cmocka_unit_test(test_summary_script),
+        cmocka_unit_test(test_warnings_and_strict),
         cmocka_unit_test(test_damaged_files),
         cmocka_unit_test(test_limits),
         cmocka_unit_test(test_restart_equivalence),

@@ -434,9 +434,77 @@ static void test_shipped_configs(void **state)
         if (rc != BK_OK)
             print_error("%s\n", err.message);
         assert_int_equal(rc, BK_OK);
+        /* What we ship draws no plausibility warning. */
+        assert_int_equal(bk_config_warnings(c, NULL, NULL), 0);
         bk_config_free(c);
     }
     globfree(&g);
+}
+
+typedef struct warnings_seen {
+    size_t count;
+    char last[BK_ERROR_MESSAGE_LEN];
+} warnings_seen;
+
+static void record_warning(void *user, const char *message)
+{
+    warnings_seen *seen = user;
+    ++seen->count;
+    snprintf(seen->last, sizeof seen->last, "%s", message);
+}
+
+/* Each plausibility warning, from the values that draw it; and none at the edges that
+ * should not (no force drop, a law without a stuck state, rows only at transitions). */
+static void test_warnings(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *overrides[3];
+        size_t n;
+        size_t count;
+        const char *needle;
+    } cases[] = {
+        {{"output.interval=1e-4"}, 1, 0, NULL},
+        /* 1 m/s meant as 1e-3: 0.6 * 9.81 N / 1e4 N/m * 100 /s = 59 mm/s at most. */
+        {{"driver.velocity=1"}, 1, 1, "[driver] velocity = 1 m/s is faster than the blocks' own slip speeds (at most 0.0589 m/s"},
+        {{"driver.velocity=-0.07"}, 1, 1, "[driver] velocity = -0.07 m/s"},
+        {{"driver.velocity=0.05"}, 1, 0, NULL},
+        {{"driver.velocity=1", "block.driver_stiffness=1"}, 2, 0, NULL}, /* a soft spring: 5.9 m/s */
+        /* A slip lasts pi / 100 s = 31 ms. */
+        {{"output.interval=0.05"}, 1, 1, "[output] interval = 0.05 s is longer than a slip (about 0.0314 s"},
+        {{"output.interval=0.03"}, 1, 0, NULL},
+        {{"output.interval=0"}, 1, 0, NULL},
+        /* The natural period is 2 pi / 100 s = 63 ms. */
+        {{"solver.max_step=0.1"}, 1, 1, "[solver] max_step = 0.1 s is longer than the fastest natural period (0.0628 s)"},
+        {{"solver.max_step=0.05"}, 1, 0, NULL},
+        {{"driver.velocity=1", "output.interval=0.05", "solver.max_step=0.1"}, 3, 3, "max_step"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        bk_config *c = NULL;
+        bk_error err = {0};
+        assert_int_equal(bk_config_load_string(minimal_config, "w.ini", cases[k].overrides, cases[k].n, &c, &err), BK_OK);
+        warnings_seen seen = {0, ""};
+        assert_int_equal(bk_config_warnings(c, record_warning, &seen), cases[k].count);
+        assert_int_equal(seen.count, cases[k].count);
+        if (cases[k].needle && !strstr(seen.last, cases[k].needle))
+            fail_msg("case %zu: \"%s\" lacks \"%s\"", k, seen.last, cases[k].needle);
+        if (cases[k].count)
+            assert_non_null(strstr(seen.last, "w.ini: "));
+        bk_config_free(c);
+    }
+    /* A law without a stuck state creeps at any driver speed: no slip-speed scale. */
+    static const char *const creeping =
+        "[model]\nn_blocks = 1\n[block]\nmass = 1\ndriver_stiffness = 1e4\n"
+        "[friction]\nlaw = dieterich_ruina_aging\nf0 = 0.6\na = 0.01\nb = 0.015\nV0 = 1e-3\nDc = 1e-5\n"
+        "[driver]\nvelocity = 10\n[catalog]\nslip_rate_threshold = 1e-3\n[run]\nt_end = 1\n";
+    bk_config *c = NULL;
+    bk_error err = {0};
+    int rc = bk_config_load_string(creeping, "dr.ini", NULL, 0, &c, &err);
+    if (rc != BK_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(rc, BK_OK);
+    assert_int_equal(bk_config_warnings(c, NULL, NULL), 0);
+    bk_config_free(c);
 }
 
 /* Inputs the fuzzers found: each is rejected with a located message, or loads into a model
@@ -498,6 +566,7 @@ int main(void)
         cmocka_unit_test(test_per_block_friction),
         cmocka_unit_test(test_many_sections),
         cmocka_unit_test(test_shipped_configs),
+        cmocka_unit_test(test_warnings),
         cmocka_unit_test(test_fuzz_regressions),
         cmocka_unit_test(test_reference),
     };

@@ -104,6 +104,14 @@ int bk_config_load_string(const char *text, const char *name, const char *const 
                           size_t n_overrides, bk_config **out, bk_error *err);
 void bk_config_free(bk_config *config);
 
+/* Values that pass every range check but are far outside what the other values make
+ * plausible (src/config_warnings.c): a driver faster than the blocks' own slip speeds, a
+ * sampling interval longer than a slip, a max_step longer than the fastest natural period.
+ * Calls warn(user, message) once per warning (each message names the file, the key and
+ * why; warn may be NULL) and returns how many there were. */
+typedef void (*bk_warning_fn)(void *user, const char *message);
+size_t bk_config_warnings(const bk_config *config, bk_warning_fn warn, void *user);
+
 /* Write the key reference (every section and key: meaning, unit, default, range) as
  * Markdown tables. */
 void bk_config_write_reference(FILE *out);

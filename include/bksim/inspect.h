@@ -16,6 +16,14 @@
  * intact file of a run that did not finish, BK_ERR_DAMAGED (message says what) or another
  * negative code for a file that cannot be read. */
 int bk_h5_info(const char *path, FILE *out, bk_error *err);
+/* Up to this many blocks bk_h5_info lists the phases block by block; a longer chain gets
+ * totals, the spread of slips per block and the most active blocks instead. */
+#define BK_INFO_TABLE_BLOCKS 20
+/* bk_h5_info with the per-block table whatever the chain's length when per_block != 0.
+ * A file a run is writing now (another process holds its lock) is read without the lock:
+ * its progress as last committed ("in progress, t = ..., N transitions so far"), no integrity
+ * check, BK_INCOMPLETE. */
+int bk_h5_info_blocks(const char *path, FILE *out, int per_block, bk_error *err);
 
 /* Integrity: root attributes present; every dataset the writer created (root attribute
  * datasets; for older files, those the stored config selects) present; every time series as

@@ -26,9 +26,10 @@ static const char *const usage_text =
     "                       (default: [output] path)\n"
     "  run --restart OUT.h5[.part] [--quiet]\n"
     "                       continue a stopped run from its last checkpoint\n"
-    "  check CONFIG [--set section.key=value]...\n"
+    "  check CONFIG [--set section.key=value]... [--strict]\n"
     "                       validate CONFIG without running\n"
-    "  info OUT.h5          summarise an output file\n"
+    "  info OUT.h5 [--blocks]\n"
+    "                       summarise an output file (or a running run's progress)\n"
     "  export OUT.h5 [--datasets a,b,...] [--block I] [--transitions]\n"
     "                       print columns for gnuplot and shell tools\n"
     "  export OUT.h5 --events\n"
@@ -45,7 +46,7 @@ static const char *const usage_text =
 
 static const char *const run_help =
     "usage: bksim run CONFIG [-o OUT] [--set section.key=value]... [--quiet] [--force|--resume]\n"
-    "                 [--point NAME]\n"
+    "                 [--point NAME] [--strict]\n"
     "       bksim run --restart OUT.h5[.part] [--quiet]\n"
     "\n"
     "Runs the scene described by the INI file CONFIG and writes an HDF5 time series.\n"
@@ -61,21 +62,34 @@ static const char *const run_help =
     "  --resume           continue OUT.part from its checkpoint when it holds one that\n"
     "                     verifies, else start over: what a batch script reruns\n"
     "  --point NAME       the sweep grid point this run is, recorded in OUT (attribute point)\n"
+    "  --strict           refuse (exit 2) a config that draws a warning: a value far outside\n"
+    "                     what the others make plausible (see `bksim check --help`)\n"
     "The file is written as OUT.part and renamed to OUT when the run completes; a failed\n"
     "or interrupted run leaves OUT.part marked complete = 0.\n";
 
 static const char *const check_help =
-    "usage: bksim check CONFIG [--set section.key=value]...\n"
+    "usage: bksim check CONFIG [--set section.key=value]... [--strict]\n"
     "\n"
-    "Validates CONFIG (and the overrides) exactly as `run` would, writes nothing.\n";
+    "Validates CONFIG (and the overrides) exactly as `run` would, writes nothing.  Values\n"
+    "within their ranges but far outside what the others make plausible get a warning on\n"
+    "stderr naming the key and why (run prints them too): a driver faster than the blocks'\n"
+    "own slip speeds, an [output] interval longer than a slip, a [solver] max_step longer\n"
+    "than the fastest natural period.\n"
+    "  --strict   make those warnings errors (exit 2), for batch scripts\n";
 
 static const char *const info_help =
-    "usage: bksim info OUT.h5\n"
+    "usage: bksim info OUT.h5 [--blocks]\n"
     "\n"
-    "Prints the parameters, stick/slip phase counts per block and solver statistics, and\n"
-    "checks the file: datasets present and equally long, time strictly increasing, the\n"
-    "complete flag.  Exit status 0: intact and complete; 3: intact but the run did not\n"
-    "finish (e.g. OUT.h5.part of an interrupted run); 1: damaged or unreadable.\n";
+    "Prints the parameters, stick/slip phase counts and solver statistics, and checks the\n"
+    "file: datasets present and equally long, time strictly increasing, the complete flag.\n"
+    "Chains of up to 20 blocks get one line per block; longer ones totals, the spread of\n"
+    "slips per block and the most active blocks.\n"
+    "  --blocks   one line per block whatever the chain's length\n"
+    "On the .part of a run still going (it holds the file's lock) it reports the progress\n"
+    "the run last committed (about once a second): in progress, t = ..., N transitions so\n"
+    "far, and its last checkpoint.\n"
+    "Exit status 0: intact and complete; 3: intact but the run did not finish (e.g.\n"
+    "OUT.h5.part of an interrupted run) or is still running; 1: damaged or unreadable.\n";
 
 static const char *const export_help =
     "usage: bksim export OUT.h5 [--datasets a,b,...] [--block I] [--transitions]\n"
@@ -190,6 +204,7 @@ typedef struct config_args {
     int quiet;
     int force;
     int resume;
+    int strict;
 } config_args;
 
 static int parse_config_args(const char *command, int argc, char **argv, config_args *args)
@@ -213,6 +228,8 @@ static int parse_config_args(const char *command, int argc, char **argv, config_
             if (i + 1 >= argc)
                 return usage_error(command, "%s needs a path", a);
             args->output = argv[++i];
+        } else if (strcmp(a, "--strict") == 0) {
+            args->strict = 1;
         } else if (allow_output && (strcmp(a, "-q") == 0 || strcmp(a, "--quiet") == 0)) {
             args->quiet = 1;
         } else if (allow_output && strcmp(a, "--force") == 0) {
@@ -236,10 +253,11 @@ static int parse_config_args(const char *command, int argc, char **argv, config_
         }
     }
     if (args->restart) {
-        if (args->config_path || args->n_overrides || args->output || args->point || args->resume)
-            return usage_error(command, "%s", "--restart takes no CONFIG, -o, --set, --point or "
-                                              "--resume: the run continues with the config stored "
-                                              "in its file");
+        if (args->config_path || args->n_overrides || args->output || args->point || args->resume ||
+            args->strict)
+            return usage_error(command, "%s", "--restart takes no CONFIG, -o, --set, --point, "
+                                              "--resume or --strict: the run continues with the "
+                                              "config stored in its file");
         return 0;
     }
     if (args->force && args->resume)
@@ -249,6 +267,11 @@ static int parse_config_args(const char *command, int argc, char **argv, config_
     return 0;
 }
 
+static void print_warning(void *user, const char *message)
+{
+    fprintf(stderr, "%s%s\n", *(const int *)user ? "error (--strict): " : "warning: ", message);
+}
+
 static int load_config(const config_args *args, bk_config **config)
 {
     bk_error err = {0};
@@ -256,6 +279,13 @@ static int load_config(const config_args *args, bk_config **config)
     if (rc != BK_OK) {
         fprintf(stderr, "%s\n", err.message);
         return rc == BK_ERR_CONFIG ? EXIT_USAGE : EXIT_RUN_FAILED;
+    }
+    /* Plausible but suspicious values: said, and with --strict refused before any output. */
+    int strict = args->strict;
+    if (bk_config_warnings(*config, print_warning, &strict) > 0 && strict) {
+        bk_config_free(*config);
+        *config = NULL;
+        return EXIT_USAGE;
     }
     return 0;
 }
@@ -480,10 +510,22 @@ static int cmd_info(int argc, char **argv)
         fputs(info_help, stdout);
         return 0;
     }
-    if (argc != 1)
-        return usage_error("info", "%s", argc == 0 ? "missing OUT.h5" : "expects exactly one file");
+    const char *path = NULL;
+    int per_block = 0;
+    for (int i = 0; i < argc; ++i) {
+        if (strcmp(argv[i], "--blocks") == 0)
+            per_block = 1;
+        else if (argv[i][0] == '-')
+            return usage_error("info", "unknown option '%s'", argv[i]);
+        else if (path)
+            return usage_error("info", "%s", "expects exactly one file");
+        else
+            path = argv[i];
+    }
+    if (!path)
+        return usage_error("info", "%s", "missing OUT.h5");
     bk_error err = {0};
-    int rc = bk_h5_info(argv[0], stdout, &err);
+    int rc = bk_h5_info_blocks(path, stdout, per_block, &err);
     if (rc == BK_INCOMPLETE)
         return EXIT_INCOMPLETE;
     if (rc != BK_OK) {

@@ -542,8 +542,12 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
     memset(&slot, 0, sizeof slot);
     const bk_checkpoint *cp = &slot.checkpoint;
     const bk_checkpoint_record *rec = &slot.record;
-    w->file = H5Fopen(w->part, H5F_ACC_RDWR, H5P_DEFAULT);
-    rc = w->file < 0 ? H5_FAIL(err, "%s: cannot open for the restart", w->part) : BK_OK;
+    if (bk_output_write_locked(w->part))
+        rc = BK_FAIL(err, BK_ERR_IO, BK_OUTPUT_OWNED_MESSAGE, w->part);
+    else
+        w->file = H5Fopen(w->part, H5F_ACC_RDWR, H5P_DEFAULT);
+    if (rc == BK_OK)
+        rc = w->file < 0 ? H5_FAIL(err, "%s: cannot open for the restart", w->part) : BK_OK;
     /* HDF5 writes the superblock, which holds the end of allocated space (EOA), last in a
      * flush; a kill inside a flush can leave blocks written past the EOA it records.  Space
      * freed there (a chunk dropped by the truncation below) would then be handed out again

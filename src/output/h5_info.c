@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "output/h5_impl.h"
+#include "output/paths.h"
 
 /* Unit of key in a "key: unit, key: unit" list; "" when not listed. */
 static void unit_of(const char *units, const char *key, char *buf, size_t len)
@@ -152,8 +153,151 @@ static int count_phases(hid_t file, const char *path, size_t n_blocks, long *sti
     return rc;
 }
 
+static int by_value(const void *a, const void *b)
+{
+    long x = *(const long *)a, y = *(const long *)b;
+    return (x > y) - (x < y);
+}
+
+/* A long chain's phases in a few lines: totals, the spread of slips per block, the most
+ * active blocks.  -1 when out of memory. */
+static int print_phase_summary(FILE *out, const char *path, size_t n, const long *stick,
+                               const long *slip)
+{
+    long *sorted = malloc(n * sizeof *sorted);
+    if (!sorted)
+        return -1;
+    long stick_total = 0, slip_total = 0;
+    size_t never = 0;
+    for (size_t i = 0; i < n; ++i) {
+        stick_total += stick[i];
+        slip_total += slip[i];
+        never += slip[i] == 0;
+        sorted[i] = slip[i];
+    }
+    qsort(sorted, n, sizeof *sorted, by_value);
+    fprintf(out, "phases per block: %zu blocks, %ld stick and %ld slip phases in all\n", n, stick_total,
+            slip_total);
+    fprintf(out, "    slips per block: min %ld, lower quartile %ld, median %ld, upper quartile %ld, "
+                 "max %ld; %zu block%s never slipped\n",
+            sorted[0], sorted[n / 4], sorted[n / 2], sorted[3 * n / 4], sorted[n - 1], never,
+            never == 1 ? "" : "s");
+    free(sorted);
+    /* The five most active, by slips (the lower index first on a tie). */
+    fprintf(out, "    most active:");
+    size_t shown[5];
+    size_t n_shown = 0;
+    for (size_t k = 0; k < 5 && k < n; ++k) {
+        size_t best = n;
+        for (size_t i = 0; i < n; ++i) {
+            int taken = 0;
+            for (size_t j = 0; j < n_shown; ++j)
+                taken |= shown[j] == i;
+            if (!taken && (best == n || slip[i] > slip[best]))
+                best = i;
+        }
+        shown[n_shown++] = best;
+        fprintf(out, "%s block %zu (%ld slips)", k ? "," : "", best, slip[best]);
+    }
+    fprintf(out, "\n    (one line per block: bksim info %s --blocks)\n", path);
+    return 0;
+}
+
+/* Rows of a dataset as the file last flushed it; 0 when it cannot be read. */
+static unsigned long long flushed_rows(hid_t file, const char *name)
+{
+    hsize_t dims[2] = {0, 0};
+    hid_t dset = H5Lexists(file, name, H5P_DEFAULT) > 0 ? H5Dopen2(file, name, H5P_DEFAULT)
+                                                          : H5I_INVALID_HID;
+    hid_t space = dset >= 0 ? H5Dget_space(dset) : H5I_INVALID_HID;
+    if (space < 0 || H5Sget_simple_extent_dims(space, dims, NULL) < 0)
+        dims[0] = 0;
+    CLOSE_IDS(0, space, dset);
+    return (unsigned long long)dims[0];
+}
+
+/* The time of the newest checkpoint slot of file (by its sequence); NaN when none. */
+static double newest_checkpoint(hid_t file)
+{
+    static const char *const slots[] = {"checkpoint/a", "checkpoint/b"};
+    double t_newest = NAN, newest = -1.0;
+    if (H5Lexists(file, "checkpoint", H5P_DEFAULT) <= 0)
+        return NAN;
+    for (int k = 0; k < 2; ++k) {
+        if (H5Lexists(file, slots[k], H5P_DEFAULT) <= 0)
+            continue;
+        hid_t slot = H5Gopen2(file, slots[k], H5P_DEFAULT);
+        double sequence = NAN, t = NAN;
+        if (slot >= 0 && bk_h5_read_numeric_attr(slot, "sequence", H5T_NATIVE_DOUBLE, &sequence) >= 0 &&
+            bk_h5_read_numeric_attr(slot, "t", H5T_NATIVE_DOUBLE, &t) >= 0 && sequence > newest) {
+            newest = sequence;
+            t_newest = t;
+        }
+        CLOSE_IDS(0, slot);
+    }
+    return t_newest;
+}
+
+/* A file a run is writing now: what it last committed (about once a second), read without
+ * taking the lock the writer holds.  No integrity check: the file is not finished. */
+static int info_in_progress(const char *path, FILE *out, bk_error *err)
+{
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    hid_t file = fapl >= 0 && H5Pset_file_locking(fapl, 0, 1) >= 0
+                     ? H5Fopen(path, H5F_ACC_RDONLY, fapl)
+                     : H5I_INVALID_HID;
+    CLOSE_IDS(0, fapl);
+    fprintf(out, "file         %s\n", path);
+    if (file < 0) {
+        fprintf(out, "status       in progress: a run is writing this file (it holds its lock); "
+                     "nothing it has flushed can be read yet\n");
+        return BK_INCOMPLETE;
+    }
+    char *name = bk_h5_read_string_attr(file, "config_name");
+    double t_end = NAN, t_reached = NAN;
+    bk_h5_read_numeric_attr(file, "t_end", H5T_NATIVE_DOUBLE, &t_end);
+    bk_h5_read_numeric_attr(file, "t_reached", H5T_NATIVE_DOUBLE, &t_reached);
+    unsigned long long transitions = flushed_rows(file, "transitions");
+    unsigned long long events = flushed_rows(file, "events");
+    unsigned long long rows = flushed_rows(file, "time");
+    /* Rows may be sparse (interval = 0): the last checkpoint can be later than the last row. */
+    double t_checkpoint = newest_checkpoint(file);
+    if (t_checkpoint > t_reached)
+        t_reached = t_checkpoint;
+    if (H5Lexists(file, "transitions", H5P_DEFAULT) > 0)
+        fprintf(out, "status       in progress, t = %.9g s of %.9g s, %llu transitions so far\n",
+                t_reached, t_end, transitions);
+    else
+        fprintf(out, "status       in progress, t = %.9g s of %.9g s (transitions not recorded)\n",
+                t_reached, t_end);
+    fprintf(out, "             (a run is writing this file: this is what it last committed; it "
+                 "commits about once a second and at each checkpoint)\n");
+    fprintf(out, "config name  %s\n", name ? name : "?");
+    if (isfinite(t_checkpoint))
+        fprintf(out, "checkpoint   t = %.17g s (if the run stops, `bksim run --restart %s` "
+                     "continues from it)\n", t_checkpoint, path);
+    else
+        fprintf(out, "checkpoint   none yet\n");
+    fprintf(out, "rows         %llu so far\n", rows);
+    if (H5Lexists(file, "events", H5P_DEFAULT) > 0)
+        fprintf(out, "events       %llu so far\n", events);
+    free(name);
+    bk_h5_close_id(file);
+    if (ferror(out))
+        return BK_FAIL(err, BK_ERR_IO, "cannot write the summary");
+    return BK_INCOMPLETE;
+}
+
 int bk_h5_info(const char *path, FILE *out, bk_error *err)
 {
+    return bk_h5_info_blocks(path, out, 0, err);
+}
+
+int bk_h5_info_blocks(const char *path, FILE *out, int per_block, bk_error *err)
+{
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    if (path && bk_output_write_locked(path))
+        return info_in_progress(path, out, err);
     hid_t file;
     int rc = bk_h5_open_input(path, &file, err);
     if (rc != BK_OK)
@@ -235,10 +379,12 @@ int bk_h5_info(const char *path, FILE *out, bk_error *err)
     print_indented(out, config ? config : "(not stored)");
     if (phases != BK_OK) {
         fprintf(out, "phases per block: not counted (%s)\n", phase_err.message);
-    } else {
+    } else if (per_block || n_blocks <= BK_INFO_TABLE_BLOCKS) {
         fprintf(out, "phases per block:\n");
         for (long long i = 0; i < n_blocks; ++i)
             fprintf(out, "    block %lld: %ld stick, %ld slip\n", i, stick[i], slip[i]);
+    } else if (print_phase_summary(out, path, (size_t)n_blocks, stick, slip) != 0) {
+        fprintf(out, "phases per block: not summarised (out of memory; --blocks lists them)\n");
     }
     if (phases != BK_OK && have_transitions)
         fprintf(out, "transitions  %ld (not all readable)\n", total);

@@ -10,6 +10,7 @@
 
 #include "capacity.h"
 #include "output/h5_impl.h"
+#include "output/paths.h"
 
 int bk_h5_open_input(const char *path, hid_t *file, bk_error *err)
 {
@@ -28,6 +29,10 @@ int bk_h5_open_input(const char *path, hid_t *file, bk_error *err)
                        path);
     if (is_hdf5 < 0)
         return H5_FAIL(err, "%s: cannot read", path);
+    if (bk_output_write_locked(path))
+        return BK_FAIL(err, BK_ERR_IO,
+                       "%s: a run is still writing this file (it holds the file's lock): read it "
+                       "when the run has finished; `bksim info` shows its progress now", path);
     *file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     int partial = bk_output_is_part(path);
     if (*file < 0)

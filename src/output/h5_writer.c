@@ -315,6 +315,12 @@ int bk_h5_writer_open(bk_h5_writer **out, const bk_config *config, const char *p
     int rc = bk_h5_writer_new(&w, path, err);
     if (rc != BK_OK)
         return rc;
+    /* Creating truncates before HDF5 would see the other run's lock: ask first. */
+    if (bk_output_write_locked(w->part)) {
+        rc = BK_FAIL(err, BK_ERR_IO, BK_OUTPUT_OWNED_MESSAGE, w->part);
+        bk_h5_writer_free(w);
+        return rc;
+    }
     rc = bk_output_make_parent_dirs(path, err);
     if (rc != BK_OK) {
         bk_h5_writer_free(w);

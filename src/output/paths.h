@@ -13,4 +13,14 @@ int bk_output_durable_rename(const char *part, const char *path, bk_error *err);
  * the run, not all in the final fsync, and dirty memory stays bounded. */
 void bk_output_write_behind(int fd);
 
+/* 1 when another process holds path's write lock, else 0 (also when path cannot be
+ * opened).  HDF5 1.10 takes flock(LOCK_EX) on a file it writes and keeps it until the file
+ * is closed, so this is "a run is writing path now".  Call it before opening path here:
+ * flock conflicts between descriptors of one process too. */
+int bk_output_write_locked(const char *path);
+/* The refusal when it is (one argument: the path). */
+#define BK_OUTPUT_OWNED_MESSAGE                                                               \
+    "%s: another run owns this file: it is writing it now (it holds the file's lock); wait " \
+    "for it to finish (`bksim info` shows its progress), or write elsewhere with -o"
+
 #endif

@@ -55,6 +55,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             for (size_t k = 0; k < c->prescribed->n_segments; ++k)
                 if (!(c->prescribed->duration[k] > 0.0) || !(c->prescribed->slip_rate[k] >= 0.0))
                     abort();
+        /* The plausibility checks take any config that loads (at most one warning each). */
+        if (bk_config_warnings(c, NULL, NULL) > 3)
+            abort();
         bk_config_free(c);
     }
     free(text);
