@@ -1,19 +1,38 @@
 #!/usr/bin/env bash
-# Apparent coefficient of friction (friction / normal force) of block 0 against time, one
-# panel per run, stacked in the order given.
+# Apparent coefficient of friction (friction / normal force) of one block against time, one
+# panel per run, stacked in the order given.  Legends sit outside the panels and the value
+# axes leave a margin, so no curve lies on the frame or under a legend.
 # Optional XRANGE=lo:hi (s) zooms in time; the value axes then fit the visible data.
-# usage: plot_cof.sh OUT.png "TITLE" RUN.h5:LABEL:COLOR [RUN.h5:LABEL:COLOR]...
+# usage: plot_cof.sh [--format png|pdf|svg] [--block I] OUT "TITLE" RUN.h5:LABEL:COLOR [RUN.h5:LABEL:COLOR]...
+#   --format   gnuplot's cairo terminal (default png); OUT is written as given
+#   --block I  the block to draw (default 0)
 set -euo pipefail
+here=$(dirname "$0")
+source "$here/plot_lib.sh"
 bksim=${BKSIM:-./bksim}
+usage() { sed -n 's/^# usage: /usage: /p' "$0" >&2; exit 2; }
+format=png; block=0
+while [ $# -gt 0 ]; do
+    case $1 in
+        --format) [ $# -ge 2 ] || usage; format=$2; shift 2 ;;
+        --block) [ $# -ge 2 ] || usage; block=$2; shift 2 ;;
+        -h|--help) sed -n '2,9s/^# \{0,1\}//p' "$0"; exit 0 ;;
+        -*) echo "plot_cof.sh: unknown option '$1'" >&2; usage ;;
+        *) break ;;
+    esac
+done
+[ $# -ge 3 ] || usage
+terminal=$(plot_terminal "$format") || usage
+plot_check_block "$block" || usage
 out=$1; title=$2; shift 2
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 
 panels=""; k=0
 for spec in "$@"; do
     IFS=: read -r file label color <<<"$spec"
-    "$bksim" export "$file" --datasets time,cof --block 0 > "$tmp/$k.dat"
+    "$bksim" export "$file" --datasets time,cof --block "$block" > "$tmp/$k.dat"
     last=$(( $# - 1 ))
-    if [ $k -eq $last ]; then xfmt="set format x '%g'; set xlabel 'time [s]'"; else xfmt="set format x ''; unset xlabel"; fi
+    if [ $k -eq $last ]; then xfmt="set format x '%g'; set xlabel 'time (s)'"; else xfmt="set format x ''; unset xlabel"; fi
     panels="$panels
 $xfmt
 plot '$tmp/$k.dat' using 1:2 with lines lc rgb '$color' lw 1.5 title '$label'"
@@ -21,13 +40,17 @@ plot '$tmp/$k.dat' using 1:2 with lines lc rgb '$color' lw 1.5 title '$label'"
 done
 
 gnuplot <<GP
-set terminal pngcairo size 1200,800 font 'Sans,13' noenhanced
+set terminal $terminal
 set output '$out'
 set multiplot layout $#,1 title '$title'
 set grid
 ${XRANGE:+set xrange [$XRANGE]}
-set key top right
-set ylabel 'apparent COF [1]'
+set offsets 0, 0, graph 0.08, graph 0.08
+set key outside right top
+# Fixed margins: panels line up whatever their legends' widths.
+set lmargin at screen 0.09
+set rmargin at screen 0.80
+set ylabel 'apparent COF, block $block'
 $panels
 unset multiplot
 GP

@@ -1,24 +1,39 @@
 #!/usr/bin/env bash
 # Paper Figure 2: the coefficient of friction against nondimensional slip distance (slip / L0)
 # under a prescribed slip-rate schedule.
-# usage: plot_fig2.sh OUT.png RUN.h5 [L0 in m, default 2e-5]
+# usage: plot_fig2.sh [--format png|pdf|svg] [--block I] OUT RUN.h5 [L0 in m, default 2e-5]
 set -euo pipefail
+here=$(dirname "$0")
+source "$here/plot_lib.sh"
 bksim=${BKSIM:-./bksim}
+usage() { sed -n 's/^# usage: /usage: /p' "$0" >&2; exit 2; }
+format=png; block=0
+while [ $# -gt 0 ]; do
+    case $1 in
+        --format) [ $# -ge 2 ] || usage; format=$2; shift 2 ;;
+        --block) [ $# -ge 2 ] || usage; block=$2; shift 2 ;;
+        -*) echo "plot_fig2.sh: unknown option '$1'" >&2; usage ;;
+        *) break ;;
+    esac
+done
+[ $# -ge 2 ] || usage
+terminal=$(plot_terminal "$format") || usage
+plot_check_block "$block" || usage
 out=$1; run=$2; L0=${3:-2e-5}
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-"$bksim" export "$run" --datasets time,x,v,cof --block 0 > "$tmp/data"
+"$bksim" export "$run" --datasets time,x,v,cof --block "$block" > "$tmp/data"
 gnuplot <<GP
-set terminal pngcairo size 1200,800 font 'Sans,13' noenhanced
+set terminal $terminal
 set output '$out'
-set title 'Figure 2: rate-and-state COF under velocity steps 1 -> 10 -> 1 mm/s'
+set title 'Figure 2: rate-and-state COF under velocity steps 1 → 10 → 1 mm/s'
 set grid
-set xlabel 'slip distance / L0 [1]   (L0 = $L0 m)'
-set ylabel 'coefficient of friction [1]'
-set key bottom right
+set xlabel 'slip distance / L0   (L0 = $L0 m)'
+set ylabel 'coefficient of friction μ'
+set key at graph 0.02, graph 0.04 left bottom Left reverse box opaque
 set label 1 'A: 1 mm/s' at graph 0.15, graph 0.95 center
 set label 2 'B: 10 mm/s' at graph 0.5, graph 0.95 center
 set label 3 'C: 1 mm/s' at graph 0.85, graph 0.95 center
-plot '$tmp/data' using (\$2/$L0):4 with lines lc rgb 'red' lw 2 title 'rate-and-state (eqs. 1-4, v_theta_ref = v0)', \
-     0.5368 with lines dt 2 lc rgb '#777777' title 'steady state at 1 mm/s (0.5368)', \
-     0.5 with lines dt 3 lc rgb '#777777' title 'steady state at 10 mm/s (0.5000)'
+plot '$tmp/data' using (\$2/$L0):4 with lines lc rgb 'red' lw 2 title 'rate-and-state (eqs. 1–4)', \
+     0.5368 with lines dt 2 lc rgb '#777777' title 'steady state, 1 mm/s (0.5368)', \
+     0.5 with lines dt 3 lc rgb '#777777' title 'steady state, 10 mm/s (0.5000)'
 GP

@@ -1,10 +1,29 @@
 #!/usr/bin/env bash
-# Position (top) and velocity (bottom) of block 0 and the driver against time.
+# Position (top) and velocity (bottom) of one block and the driver against time.  Legends sit
+# outside the panels and the value axes leave a margin, so no curve lies under a legend.
 # Optional XRANGE=lo:hi (s) zooms in time; the value axes then fit the visible data.
-# usage: plot_kinematics.sh OUT.png "TITLE" RUN.h5:LABEL:COLOR [RUN.h5:LABEL:COLOR]...
+# usage: plot_kinematics.sh [--format png|pdf|svg] [--block I] OUT "TITLE" RUN.h5:LABEL:COLOR [RUN.h5:LABEL:COLOR]...
+#   --format   gnuplot's cairo terminal (default png); OUT is written as given
+#   --block I  the block to draw (default 0)
 # The driver (grey) is taken from the first run.  Data come through `bksim export`.
 set -euo pipefail
+here=$(dirname "$0")
+source "$here/plot_lib.sh"
 bksim=${BKSIM:-./bksim}
+usage() { sed -n 's/^# usage: /usage: /p' "$0" >&2; exit 2; }
+format=png; block=0
+while [ $# -gt 0 ]; do
+    case $1 in
+        --format) [ $# -ge 2 ] || usage; format=$2; shift 2 ;;
+        --block) [ $# -ge 2 ] || usage; block=$2; shift 2 ;;
+        -h|--help) sed -n '2,9s/^# \{0,1\}//p' "$0"; exit 0 ;;
+        -*) echo "plot_kinematics.sh: unknown option '$1'" >&2; usage ;;
+        *) break ;;
+    esac
+done
+[ $# -ge 3 ] || usage
+terminal=$(plot_terminal "$format") || usage
+plot_check_block "$block" || usage
 out=$1; title=$2; shift 2
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 
@@ -12,7 +31,7 @@ pos_plot=""; vel_plot=""; k=0
 for spec in "$@"; do
     IFS=: read -r file label color <<<"$spec"
     # Column 5: driver velocity by finite differences over rows at least 1 us apart.
-    "$bksim" export "$file" --datasets time,driver,x,v --block 0 |
+    "$bksim" export "$file" --datasets time,driver,x,v --block "$block" |
         awk '/^#/ {next} { if (n++ && $1 - t > 1e-6) u = ($2 - d) / ($1 - t)
                            if (n == 1 || $1 - t > 1e-6) { t = $1; d = $2 }
                            print $0, (n > 1 ? u : "NaN") }' > "$tmp/$k.dat"
@@ -26,18 +45,22 @@ for spec in "$@"; do
 done
 
 gnuplot <<GP
-set terminal pngcairo size 1200,800 font 'Sans,13' noenhanced
+set terminal $terminal
 set output '$out'
 set multiplot layout 2,1 title '$title'
 set grid
 ${XRANGE:+set xrange [$XRANGE]}
-set key top left
-set ylabel 'position [mm]'
+set offsets 0, 0, graph 0.05, graph 0.05
+set key outside right top
+# Fixed margins: panels line up whatever their legends' widths.
+set lmargin at screen 0.09
+set rmargin at screen 0.80
+set ylabel 'position, block $block (mm)'
 set format x ''
 plot $pos_plot
 set format x '%g'
-set xlabel 'time [s]'
-set ylabel 'velocity [mm/s]'
+set xlabel 'time (s)'
+set ylabel 'velocity, block $block (mm/s)'
 plot $vel_plot
 unset multiplot
 GP

@@ -20,10 +20,10 @@ for c in a b c; do
     C=$(echo "$c" | tr a-z A-Z)
     mu=$(awk -F'[=;]' '$1 ~ /^mu_d/ {gsub(/ /, "", $2); print $2}' "configs/paper/case_${c}_coulomb.ini")
     scripts/plot_kinematics.sh "$out/fig${fig}_case_${c}_kinematics.png" \
-        "Figure $fig: case $C (mu_d = $mu), position and velocity of block and driver" \
+        "Figure $fig: case $C (μ_d = $mu), position and velocity of block and driver" \
         "$out/case_${c}_coulomb.h5:Coulomb:black" "$out/case_${c}_rs.h5:rate-and-state:red"
     scripts/plot_cof.sh "$out/fig$((fig + 1))_case_${c}_cof.png" \
-        "Figure $((fig + 1)): case $C (mu_d = $mu), apparent COF (friction / normal force)" \
+        "Figure $((fig + 1)): case $C (μ_d = $mu), apparent COF (friction / normal force)" \
         "$out/case_${c}_coulomb.h5:Coulomb:black" "$out/case_${c}_rs.h5:rate-and-state:red"
     fig=$((fig + 2))
 done

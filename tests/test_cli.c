@@ -783,6 +783,32 @@ static void test_warnings_and_strict(void **state)
     expect_command("./bksim check configs/paper/case_a_coulomb.ini --strict", 0, ": ok: ");
 }
 
+/* The paper's plot scripts: any block, png/pdf/svg, and a clear refusal of bad options. */
+static void test_plot_scripts(void **state)
+{
+    (void)state;
+    char run[512], cmd[2048];
+    snprintf(run, sizeof run, "%s/plot_two.h5", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run configs/chains/two_block_coulomb.ini -q -o %s", run);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    const char *bin = bksim_binary();
+    static const char *const scripts[] = {"plot_cof.sh", "plot_kinematics.sh"};
+    for (size_t k = 0; k < 2; ++k) {
+        snprintf(cmd, sizeof cmd,
+                 "BKSIM=%s scripts/%s --format svg --block 1 %s/fig_%zu.svg 'two blocks' %s:block:black && "
+                 "grep -c '<svg' %s/fig_%zu.svg && grep -c 'block 1' %s/fig_%zu.svg",
+                 bin, scripts[k], tmpdir, k, run, tmpdir, k, tmpdir, k);
+        assert_int_equal(run_command(cmd, NULL), 0);
+        snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/%s --format pdf %s/fig_%zu.pdf t %s:b:black && "
+                 "head -c 5 %s/fig_%zu.pdf | grep -q '%%PDF'", bin, scripts[k], tmpdir, k, run, tmpdir, k);
+        assert_int_equal(run_command(cmd, NULL), 0);
+        snprintf(cmd, sizeof cmd, "scripts/%s --format gif %s/x t %s:b:black", scripts[k], tmpdir, run);
+        expect_command(cmd, 2, "--format must be png, pdf or svg");
+        snprintf(cmd, sizeof cmd, "scripts/%s --block -1 %s/x t %s:b:black", scripts[k], tmpdir, run);
+        expect_command(cmd, 2, "--block needs a block index");
+    }
+}
+
 /* A damaged file is reported as such: truncated, or hand-edited inconsistent. */
 static void test_damaged_files(void **state)
 {
@@ -1177,6 +1203,7 @@ int main(void)
         cmocka_unit_test(test_info_at_chain_scale),
         cmocka_unit_test(test_summary_script),
         cmocka_unit_test(test_warnings_and_strict),
+        cmocka_unit_test(test_plot_scripts),
         cmocka_unit_test(test_damaged_files),
         cmocka_unit_test(test_limits),
         cmocka_unit_test(test_restart_equivalence),
