@@ -11,19 +11,14 @@ here=$(dirname "$0")
 source "$here/plot_lib.sh"
 bksim=${BKSIM:-./bksim}
 usage() { sed -n 's/^# usage: /usage: /p' "$0" >&2; exit 2; }
-format=png; block=0
-while [ $# -gt 0 ]; do
-    case $1 in
-        --format) [ $# -ge 2 ] || usage; format=$2; shift 2 ;;
-        --block) [ $# -ge 2 ] || usage; block=$2; shift 2 ;;
-        -h|--help) sed -n '2,9s/^# \{0,1\}//p' "$0"; exit 0 ;;
-        -*) echo "plot_cof.sh: unknown option '$1'" >&2; usage ;;
-        *) break ;;
-    esac
-done
+status=0
+plot_options "$@" || status=$?
+[ $status -eq 3 ] && { sed -n '2,9s/^# \{0,1\}//p' "$0"; exit 0; }
+[ $status -eq 0 ] || usage
+shift "$PLOT_SHIFT"
 [ $# -ge 3 ] || usage
-terminal=$(plot_terminal "$format") || usage
-plot_check_block "$block" || usage
+terminal=$PLOT_TERMINAL
+block=$PLOT_BLOCK
 out=$1; title=$2; shift 2
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 

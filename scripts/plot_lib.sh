@@ -14,3 +14,26 @@ plot_terminal() {
 plot_check_block() {
     [[ $1 =~ ^[0-9]+$ ]] || { echo "--block needs a block index >= 0, got '$1'" >&2; return 2; }
 }
+
+# plot_options "$@": the options every paper figure takes, --format F and --block I, up to
+# the first argument that is none.  Sets PLOT_TERMINAL, PLOT_BLOCK and PLOT_SHIFT (how many
+# arguments it took).  Returns 2 on a bad or unknown option (said on stderr), 3 for --help.
+plot_options() {
+    local format=png
+    PLOT_BLOCK=0
+    PLOT_SHIFT=0
+    while [ $# -gt 0 ]; do
+        case $1 in
+            --format|--block)
+                [ $# -ge 2 ] || { echo "$1 needs a value" >&2; return 2; }
+                if [ "$1" = --format ]; then format=$2; else PLOT_BLOCK=$2; fi
+                shift 2
+                PLOT_SHIFT=$((PLOT_SHIFT + 2)) ;;
+            -h|--help) return 3 ;;
+            -*) echo "unknown option '$1'" >&2; return 2 ;;
+            *) break ;;
+        esac
+    done
+    PLOT_TERMINAL=$(plot_terminal "$format") || return 2
+    plot_check_block "$PLOT_BLOCK" || return 2
+}
