@@ -809,6 +809,38 @@ static void test_plot_scripts(void **state)
     }
 }
 
+/* A stopped run says how to go on: the --restart command and its checkpoint's time, or that
+ * without a checkpoint it can only be run again; `bksim info` says the same of the .part;
+ * and running the same command again says that it starts over. */
+static void test_stop_messages(void **state)
+{
+    (void)state;
+    char out[512], cmd[2048];
+    const char *scene = "configs/paper/case_b_coulomb.ini --set run.t_end=1e4 --set solver.method=cvode_adams "
+                        "--set run.wall_time_limit=0.3";
+    snprintf(out, sizeof out, "%s/with_checkpoint.h5", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -q -o %s --set output.checkpoint_interval=5", scene, out);
+    char expected[1200], *text = NULL;
+    assert_int_equal(run_command(cmd, &text), 1);
+    snprintf(expected, sizeof expected, "; continue it from its checkpoint t = ");
+    assert_non_null(strstr(text, expected));
+    snprintf(expected, sizeof expected, "with `bksim run --restart %s.part`", out);
+    assert_non_null(strstr(text, expected));
+    free(text);
+    snprintf(cmd, sizeof cmd, "./bksim info %s.part", out);
+    snprintf(expected, sizeof expected, "`bksim run --restart %s.part` continues from it", out);
+    expect_command(cmd, 3, expected);
+
+    snprintf(out, sizeof out, "%s/without_checkpoint.h5", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -q -o %s", scene, out);
+    expect_command(cmd, 1, "it holds no checkpoint, so it cannot be continued: running again starts over");
+    snprintf(cmd, sizeof cmd, "./bksim info %s.part", out);
+    expect_command(cmd, 3, "checkpoint   none: this run cannot be continued, only run again");
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s", scene, out);
+    snprintf(expected, sizeof expected, "starting over: %s.part is replaced (it holds no checkpoint", out);
+    expect_command(cmd, 1, expected);
+}
+
 /* A damaged file is reported as such: truncated, or hand-edited inconsistent. */
 static void test_damaged_files(void **state)
 {
@@ -1204,6 +1236,7 @@ int main(void)
         cmocka_unit_test(test_summary_script),
         cmocka_unit_test(test_warnings_and_strict),
         cmocka_unit_test(test_plot_scripts),
+        cmocka_unit_test(test_stop_messages),
         cmocka_unit_test(test_damaged_files),
         cmocka_unit_test(test_limits),
         cmocka_unit_test(test_restart_equivalence),

@@ -162,7 +162,7 @@ static void test_killed_sweep_completes(void **state)
     snprintf(path, sizeof path, "%s/sweep.log", dir);
     assert_int_equal(count_lines(path, "skipped: finished before"), (int)done);
     assert_int_equal(count_lines(path, "FAILED"), 0);
-    int resumed = count_lines(path, "from its checkpoint");
+    int resumed = count_lines(path, "(continuing ");
     print_message("second run: %d points continued from a checkpoint\n", resumed);
 
     snprintf(path, sizeof path, "%s/direct.txt", tmpdir);
@@ -255,7 +255,7 @@ static void test_stopped_point_continues(void **state)
     snprintf(path, sizeof path, "%s/sweep.log", dir);
     assert_int_equal(count_lines(path, "friction.mu_d=0.3\tFAILED (exit 1"), 1);
     assert_int_equal(count_lines(path, "friction.mu_d=0.3\tdone in"), 1);
-    assert_int_equal(count_lines(path, "from its checkpoint"), 1);
+    assert_int_equal(count_lines(path, "(continuing "), 1);
     char out[1024], direct[1024];
     snprintf(out, sizeof out, "%s/friction.mu_d=0.3.h5", dir);
     snprintf(direct, sizeof direct, "%s/direct_resumed.h5", tmpdir);

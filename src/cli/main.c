@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -460,6 +461,13 @@ static int cmd_run(int argc, char **argv)
             free(args.overrides);
             return EXIT_USAGE;
         } else {
+            /* Never silently: a stopped run's .part without a checkpoint is replaced. */
+            char *part = malloc(strlen(path) + sizeof ".part");
+            struct stat st;
+            if (part && (sprintf(part, "%s.part", path), stat(part, &st) == 0) && !args.quiet)
+                fprintf(stderr, "bksim: starting over: %s is replaced (%s)\n", part,
+                        args.force ? "--force" : "it holds no checkpoint to continue from");
+            free(part);
             opened = bk_h5_writer_open(&writer, config, path, &err);
             if (opened == BK_OK && args.point && bk_h5_writer_set_point(writer, args.point, &err) != BK_OK) {
                 bk_h5_writer_abandon(writer, err.message, NULL);
@@ -487,7 +495,18 @@ static int cmd_run(int argc, char **argv)
     if (rc != BK_OK) {
         fprintf(stderr, "%s: %s\n", args.restart ? args.restart : args.config_path, err.message);
         bk_h5_writer_abandon(writer, err.message, &stats);
-        fprintf(stderr, "bksim: partial output left in %s.part (complete = 0)\n", path);
+        /* Say how to go on: from the last checkpoint, or (none) only by starting over. */
+        double t_checkpoint = 0.0;
+        bk_error ignored = {0};
+        if (bk_h5_restartable(path, &t_checkpoint, &ignored) == 1)
+            fprintf(stderr, "bksim: partial output left in %s.part (complete = 0); continue it from "
+                            "its checkpoint t = %.17g s with `bksim run --restart %s.part`\n",
+                    path, t_checkpoint, path);
+        else
+            fprintf(stderr, "bksim: partial output left in %s.part (complete = 0); it holds no "
+                            "checkpoint, so it cannot be continued: running again starts over "
+                            "([output] checkpoint_interval makes checkpoints)\n",
+                    path);
         status = EXIT_RUN_FAILED;
     } else if (bk_h5_writer_finish(writer, &stats, &err) != BK_OK) {
         fprintf(stderr, "%s\n", err.message);

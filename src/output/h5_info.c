@@ -368,6 +368,14 @@ int bk_h5_info_blocks(const char *path, FILE *out, int per_block, bk_error *err)
         fprintf(out, "complete     ?\n");
     if (error)
         fprintf(out, "error        %s\n", error);
+    double t_checkpoint = have_complete && !complete ? newest_checkpoint(file) : NAN;
+    if (have_complete && !complete) {
+        if (isfinite(t_checkpoint))
+            fprintf(out, "checkpoint   t = %.17g s: `bksim run --restart %s` continues from it\n",
+                    t_checkpoint, path);
+        else
+            fprintf(out, "checkpoint   none: this run cannot be continued, only run again\n");
+    }
     fprintf(out, "t_end        %.9g s\n", t_end);
     fprintf(out, "t_reached    %.9g s\n", t_reached);
     fprintf(out, "n_blocks     %lld\n", n_blocks);
