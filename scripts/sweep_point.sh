@@ -40,11 +40,13 @@ start=$(date +%s.%N)
 "$bksim" run "$dir/base.ini" -o "$out" --resume --point "$name" "${sets[@]}" >> "$log" 2>&1
 status=$?
 seconds=$(echo "$(date +%s.%N) $start" | awk '{printf "%.1f", $1 - $2}')
-resumed=$(tail -n 5 "$log" | grep -o 'continuing .* from its checkpoint t = [^ ]*' | tail -1)
+# This attempt's messages: the log's lines after its last '==' header.
+attempt=$(awk '/^== / {text = ""; next} {text = text $0 "\n"} END {printf "%s", text}' "$log")
+resumed=$(grep -o 'continuing .* from its checkpoint t = [^ ]*' <<< "$attempt" | tail -1)
 if [ $status -eq 0 ]; then
     printf '%s\t%s\tdone in %s s%s\n' "$(stamp)" "$name" "$seconds" "${resumed:+ ($resumed)}"
     exit 0
 fi
 printf '%s\t%s\tFAILED (exit %d after %s s): %s\n' "$(stamp)" "$name" "$status" "$seconds" \
-    "$(grep -v '^==' "$log" | tail -n 2 | tr '\n' ' ')"
+    "$(tail -n 2 <<< "$attempt" | tr '\n' ' ')"
 exit 1
