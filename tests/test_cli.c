@@ -819,7 +819,10 @@ static void test_stop_messages(void **state)
     const char *scene = "configs/paper/case_b_coulomb.ini --set run.t_end=1e4 --set solver.method=cvode_adams "
                         "--set run.wall_time_limit=0.3";
     snprintf(out, sizeof out, "%s/with_checkpoint.h5", tmpdir);
-    snprintf(cmd, sizeof cmd, "./bksim run %s -q -o %s --set output.checkpoint_interval=5", scene, out);
+    /* The output path from the config, not -o: --resume below must not read it from the
+     * config it replaces by the stored one. */
+    snprintf(cmd, sizeof cmd, "./bksim run %s -q --set output.path=%s --set output.checkpoint_interval=5",
+             scene, out);
     char expected[1200], *text = NULL;
     assert_int_equal(run_command(cmd, &text), 1);
     snprintf(expected, sizeof expected, "; continue it from its checkpoint t = ");
@@ -830,6 +833,10 @@ static void test_stop_messages(void **state)
     snprintf(cmd, sizeof cmd, "./bksim info %s.part", out);
     snprintf(expected, sizeof expected, "`bksim run --restart %s.part` continues from it", out);
     expect_command(cmd, 3, expected);
+    snprintf(cmd, sizeof cmd, "./bksim run %s --set output.path=%s --set output.checkpoint_interval=5 --resume",
+             scene, out);
+    snprintf(expected, sizeof expected, "bksim: continuing %s.part from its checkpoint t = ", out);
+    expect_command(cmd, 1, expected);
 
     snprintf(out, sizeof out, "%s/without_checkpoint.h5", tmpdir);
     snprintf(cmd, sizeof cmd, "./bksim run %s -q -o %s", scene, out);

@@ -426,10 +426,9 @@ static int cmd_run(int argc, char **argv)
             return EXIT_RUN_FAILED;
         }
         if (restartable == 1 && args.resume) {
-            /* The stored config is the one the run began with; this command's must match. */
-            restart_path = malloc(strlen(path) + sizeof ".part");
-            if (restart_path)
-                sprintf(restart_path, "%s.part", path);
+            /* The stored config is the one the run began with; this command's must match.  A
+             * copy of path: it may live in the config replaced here. */
+            restart_path = strdup(path);
             bk_config *given = config;
             config = NULL;
             opened = restart_path ? bk_h5_writer_resume(&writer, restart_path, &config, &checkpoint, &err)
@@ -445,10 +444,7 @@ static int cmd_run(int argc, char **argv)
                                  path);
             }
             bk_config_free(given);
-            free(restart_path);
-            restart_path = bk_output_final_path(path);
-            path = restart_path;
-            args.restart = path; /* from here on, a restarted run */
+            path = args.restart = restart_path; /* from here on, a restarted run */
             if (!args.quiet && opened == BK_OK)
                 fprintf(stderr, "bksim: continuing %s.part from its checkpoint t = %.17g s\n", path,
                         t_checkpoint);
@@ -462,9 +458,9 @@ static int cmd_run(int argc, char **argv)
             return EXIT_USAGE;
         } else {
             /* Never silently: a stopped run's .part without a checkpoint is replaced. */
-            char *part = malloc(strlen(path) + sizeof ".part");
+            char *part = bk_output_part_path(path);
             struct stat st;
-            if (part && (sprintf(part, "%s.part", path), stat(part, &st) == 0) && !args.quiet)
+            if (part && stat(part, &st) == 0 && !args.quiet)
                 fprintf(stderr, "bksim: starting over: %s is replaced (%s)\n", part,
                         args.force ? "--force" : "it holds no checkpoint to continue from");
             free(part);
