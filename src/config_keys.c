@@ -117,8 +117,9 @@ static const key_def keys[] = {
                 "build the event catalog during the run and write the /events table (README \"Earthquake catalogs and statistics\")"},
      BK_KEY_BOOLEAN, NULL, NULL, "true"},
     {"output", {"event_rows", "", NAN, 0, 1, 0,
-                "add a full row at every transition instant (an O(n_blocks) snapshot per event; the "
-                "/transitions table holds the changed block's state anyway); auto: true up to 16 blocks"},
+                "add two full rows at every transition instant, the states just before and just after it "
+                "(an O(n_blocks) snapshot per event; the /transitions table holds the changed block's state "
+                "anyway); auto: true up to 16 blocks"},
      BK_KEY_BOOLEAN, NULL, NULL, "auto"},
     NUM("output", "max_bytes", "B", 1e10, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
         "largest size the output may take: the sample rows (t_end / interval, times the bytes per row for "

@@ -24,7 +24,7 @@ typedef struct emitter {
     double *state;           /* n_state, scratch */
 } emitter;
 
-static int emit(emitter *em, double t, double slip, double rate, const double *state, int is_event)
+static int emit(emitter *em, double t, double slip, double rate, const double *state, bk_row_kind kind)
 {
     const bk_block *b = em->block;
     const bk_friction_law *law = b->law;
@@ -43,7 +43,7 @@ static int emit(emitter *em, double t, double slip, double rate, const double *s
         .cof = &cof,
         .mode = &mode,
         .friction_state = law->n_state ? state : NULL,
-        .is_event = is_event,
+        .is_event = (int)kind,
     };
     if (em->stats)
         em->stats->rows++;
@@ -98,6 +98,7 @@ int bk_run_prescribed(const bk_config *config, const bk_sink *sink, bk_run_stats
     long next_sample = 1;
     int rc = BK_OK;
     bk_mode previous_mode = BK_MODE_STICK;
+    double previous_rate = 0.0;
     for (size_t k = 0; k < pr->n_segments && segment_start < t_end && rc == BK_OK; ++k) {
         double rate = pr->slip_rate[k];
         double segment_end = k + 1 == pr->n_segments ? t_end : fmin(segment_start + pr->duration[k], t_end);
@@ -106,8 +107,15 @@ int bk_run_prescribed(const bk_config *config, const bk_sink *sink, bk_run_stats
         if (mode != previous_mode && (rc = transition(&em, segment_start, slip_start, previous_mode, mode)) != BK_OK)
             break;
         previous_mode = mode;
-        if ((rc = emit(&em, segment_start, slip_start, rate, start_state, k > 0 || mode != BK_MODE_STICK)) != BK_OK)
+        /* A rate step is an instant of two rows, before it and after (as a run's transitions). */
+        if (k > 0 || mode != BK_MODE_STICK) {
+            double t0 = segment_start, x0 = slip_start;
+            if ((rc = emit(&em, t0, x0, previous_rate, start_state, BK_ROW_BEFORE_TRANSITION)) != BK_OK ||
+                (rc = emit(&em, t0, x0, rate, start_state, BK_ROW_AFTER_TRANSITION)) != BK_OK)
+                break;
+        } else if ((rc = emit(&em, segment_start, slip_start, rate, start_state, BK_ROW_SAMPLE)) != BK_OK)
             break;
+        previous_rate = rate;
         /* Samples inside the segment; its end belongs to the next segment's first row,
          * except at t_end. */
         for (;; ++next_sample) {
@@ -119,7 +127,7 @@ int bk_run_prescribed(const bk_config *config, const bk_sink *sink, bk_run_stats
             if (ts > segment_end || (ts == segment_end && segment_end < t_end))
                 break;
             double dt = ts - segment_start;
-            if ((rc = emit(&em, ts, slip_start + rate * dt, rate, state_at(&em, start_state, rate, dt), 0)) != BK_OK ||
+            if ((rc = emit(&em, ts, slip_start + rate * dt, rate, state_at(&em, start_state, rate, dt), BK_ROW_SAMPLE)) != BK_OK ||
                 ts >= t_end)
                 break;
         }

@@ -114,7 +114,7 @@ static int close_instant(run_ctx *ctx)
         return rc;
     double t = ctx->t_row_due;
     ctx->t_row_due = NAN;
-    if ((rc = bk_run_unpack_all(ctx, t)) != BK_OK || (rc = bk_run_emit_row(ctx, t, 1)) != BK_OK)
+    if ((rc = bk_run_unpack_all(ctx, t)) != BK_OK || (rc = bk_run_emit_event_rows(ctx, t)) != BK_OK)
         return rc;
     skip_sample_at(ctx, t);
     return BK_OK;
@@ -182,7 +182,7 @@ static int schedule(run_ctx *ctx)
             break;
         case SAMPLE:
             if ((rc = bk_run_unpack_all(ctx, t_action)) == BK_OK &&
-                (rc = bk_run_emit_row(ctx, t_action, 0)) == BK_OK)
+                (rc = bk_run_emit_row(ctx, t_action, BK_ROW_SAMPLE)) == BK_OK)
                 ctx->next_sample++;
             break;
         case STOP:
@@ -194,7 +194,7 @@ static int schedule(run_ctx *ctx)
                 return rc;
             /* The final row, unless an event row at t_end took its place. */
             if (ctx->next_sample >= 0)
-                rc = bk_run_emit_row(ctx, ctx->t_end, 0);
+                rc = bk_run_emit_row(ctx, ctx->t_end, BK_ROW_SAMPLE);
             ctx->next_sample = -1;
             return rc;
         }
@@ -260,6 +260,8 @@ static void free_ctx(run_ctx *ctx)
     free(ctx->state_out);
     free(ctx->last_transition);
     free(ctx->instant_count);
+    free(ctx->mode_before);
+    free(ctx->changed);
 }
 
 /* Modes at t = 0: moving blocks slip their way, resting ones by the machine. */
@@ -359,6 +361,15 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
     }
     for (size_t i = 0; i < n; ++i)
         ctx.last_transition[i] = -INFINITY;
+    if (ctx.event_rows) {
+        ctx.mode_before = malloc(n * sizeof *ctx.mode_before);
+        ctx.changed = malloc(n * sizeof *ctx.changed);
+        if (!ctx.mode_before || !ctx.changed) {
+            rc = BK_FAIL(err, BK_ERR_NOMEM, "out of memory for %zu blocks", n);
+            goto done;
+        }
+        memset(ctx.mode_before, BK_MODE_UNCHANGED, n * sizeof *ctx.mode_before);
+    }
     /* Scales come from the initial state in a resumed run too, so both runs use the same. */
     resolve_scales(&ctx);
     if ((rc = bk_run_catalog_init(&ctx, from)) != BK_OK)
@@ -377,7 +388,7 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
         ctx.kinetic0 = bk_model_kinetic_energy(ctx.model, ctx.scene.v);
         if ((rc = bk_run_partition_all(&ctx, 0.0)) != BK_OK ||
             (rc = bk_run_flush_instant(&ctx)) != BK_OK || (rc = bk_run_unpack_all(&ctx, 0.0)) != BK_OK ||
-            (rc = bk_run_emit_row(&ctx, 0.0, moved)) != BK_OK)
+            (rc = (moved ? bk_run_emit_event_rows(&ctx, 0.0) : bk_run_emit_row(&ctx, 0.0, BK_ROW_SAMPLE))) != BK_OK)
             goto done;
         ctx.next_sample = 1;
     }

@@ -15,6 +15,9 @@
 #include "heap.h"
 #include "scene.h"
 
+/* ctx->mode_before of a block that has not changed in the open instant. */
+#define BK_MODE_UNCHANGED INT8_MIN
+
 /* An island with its own integrator (scene.h says what an island is). */
 typedef struct run_island {
     bk_island island;        /* layout and ODE; the problem's user data */
@@ -79,8 +82,12 @@ typedef struct run_ctx {
     bk_transition *instant;
     size_t n_instant, instant_capacity;
     double t_instant;
-    /* An event row owed for the instant at t_row_due (NAN: none). */
+    /* An event row owed for the instant at t_row_due (NAN: none), and the blocks changed in
+     * it with each one's mode before its first transition there (only with event rows). */
     double t_row_due;
+    int8_t *mode_before;     /* per block; BK_MODE_UNCHANGED when not changed */
+    size_t *changed;
+    size_t n_changed;
 
     /* What the rows and transitions take on disk, against [output] max_bytes. */
     double bytes_written, row_bytes, max_bytes;
@@ -187,8 +194,11 @@ int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl);
 /* ---- run_output.c ---- */
 /* Count bytes written (rows, transitions, events) against [output] max_bytes at t. */
 int bk_run_count_bytes(run_ctx *ctx, double bytes, double t);
-/* A row from the chain's arrays at t (bk_run_unpack_all first). */
+/* A row from the chain's arrays at t (bk_run_unpack_all first); is_event is a bk_row_kind. */
 int bk_run_emit_row(run_ctx *ctx, double t, int is_event);
+/* The two rows of a transition instant at t (unpacked there): the state just before its
+ * transitions, then just after. */
+int bk_run_emit_event_rows(run_ctx *ctx, double t);
 /* A mode change of block i at t with the applied force then: chattering guard, statistics,
  * and the transition, buffered until its instant ends. */
 int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_mode to,

@@ -31,7 +31,8 @@ int bk_run_count_bytes(run_ctx *ctx, double bytes, double t)
                    BK_TRANSITION_RECORD_BYTES, ctx->events, BK_EVENT_RECORD_BYTES);
 }
 
-int bk_run_emit_row(run_ctx *ctx, double t, int is_event)
+/* The row at t to the sink; the caller has checked progress and counted its bytes. */
+static int send_row(run_ctx *ctx, double t, bk_row_kind kind)
 {
     const bk_model *model = ctx->model;
     bk_scene *scene = &ctx->scene;
@@ -57,24 +58,56 @@ int bk_run_emit_row(run_ctx *ctx, double t, int is_event)
         .elastic_energy = bk_model_elastic_energy(model, scene->x, driver_pos),
         .work_driver = ctx->work,
         .dissipation = ctx->dissipation,
-        .is_event = is_event,
+        .is_event = (int)kind,
     };
-    /* Rows can come without steps (all stuck, or dense sampling): a stop request and the
-     * wall clock are checked here too, before the row counts as written. */
-    int rc = bk_run_report_progress(ctx, t);
-    if (rc != BK_OK)
-        return rc;
     ctx->t_last_row = t;
     ctx->steps_since_row = 0;
     ctx->stats->rows++;
-    if ((rc = bk_run_count_bytes(ctx, ctx->row_bytes, t)) != BK_OK)
-        return rc;
     if (ctx->sink && ctx->sink->sample) {
-        rc = ctx->sink->sample(ctx->sink->self, &sample, ctx->err);
+        int rc = ctx->sink->sample(ctx->sink->self, &sample, ctx->err);
         if (rc != BK_OK)
             return rc < 0 ? rc : BK_ERR_SINK;
     }
     return BK_OK;
+}
+
+/* Rows can come without steps (all stuck, or dense sampling): a stop request and the wall
+ * clock are checked before rows, and their bytes counted, before the first is written. */
+static int before_rows(run_ctx *ctx, double t, int rows)
+{
+    int rc = bk_run_report_progress(ctx, t);
+    return rc != BK_OK ? rc : bk_run_count_bytes(ctx, rows * ctx->row_bytes, t);
+}
+
+int bk_run_emit_row(run_ctx *ctx, double t, int is_event)
+{
+    int rc = before_rows(ctx, t, 1);
+    return rc != BK_OK ? rc : send_row(ctx, t, (bk_row_kind)is_event);
+}
+
+int bk_run_emit_event_rows(run_ctx *ctx, double t)
+{
+    int8_t *mode = ctx->scene.mode;
+    size_t n_changed = ctx->n_changed;
+    ctx->n_changed = 0;
+    /* Both rows or neither: a stop between them would leave a file with half an instant. */
+    int rc = before_rows(ctx, t, n_changed > 0 ? 2 : 1);
+    /* The before row is the after row with the changed blocks' modes put back: nothing else
+     * a row shows jumps at a transition. */
+    for (size_t k = 0; k < n_changed; ++k) {
+        size_t i = ctx->changed[k];
+        int8_t after = mode[i];
+        mode[i] = ctx->mode_before[i];
+        ctx->mode_before[i] = after;
+    }
+    if (rc == BK_OK && n_changed > 0)
+        rc = send_row(ctx, t, BK_ROW_BEFORE_TRANSITION);
+    for (size_t k = 0; k < n_changed; ++k) {
+        size_t i = ctx->changed[k];
+        mode[i] = ctx->mode_before[i];
+        ctx->mode_before[i] = BK_MODE_UNCHANGED;
+    }
+    return rc != BK_OK ? rc : send_row(ctx, t, BK_ROW_AFTER_TRANSITION);
 }
 
 static int writes_transitions(const run_ctx *ctx)
@@ -101,6 +134,10 @@ int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_
                        bk_scene_static_threshold(scene, i));
     ctx->stats->transitions++;
     ctx->steps_since_row = 0;
+    if (ctx->mode_before && ctx->mode_before[i] == BK_MODE_UNCHANGED) {
+        ctx->mode_before[i] = (int8_t)from;
+        ctx->changed[ctx->n_changed++] = i;
+    }
     bk_transition record = {
         .t = t,
         .block = (int32_t)i,

@@ -49,15 +49,15 @@ static void test_export_default_one_block(void **state)
     write_small(f->path, 0);
     char *text = export_text(f->path, NULL, 1, 0);
     char expected[2048] =
-        "# time[s] driver[m] x_1[m] v_1[m/s] friction_1[N] cof_1[1] mode_1[1]\n";
+        "# time[s] event[1] driver[m] x_1[m] v_1[m/s] friction_1[N] cof_1[1] mode_1[1]\n";
     for (int r = 0; r < 3; ++r)
-        append(expected, sizeof expected, "%.17g %.17g %.17g %.17g %.17g %.17g %d\n", 0.1 * r,
+        append(expected, sizeof expected, "%.17g %d %.17g %.17g %.17g %.17g %.17g %d\n", 0.1 * r, 0,
                0.7 * r, 0.1 * (r + 1) + 1, -0.3 + r, 1.0 / 3.0 + 1, 0.6, 0);
     assert_string_equal(text, expected);
     /* %.17g round-trips: the printed x column parses back to the stored doubles. */
     const char *line = strchr(text, '\n') + 1;
-    double t, d, x1;
-    assert_int_equal(sscanf(line, "%lf %lf %lf", &t, &d, &x1), 3);
+    double t, e, d, x1;
+    assert_int_equal(sscanf(line, "%lf %lf %lf %lf", &t, &e, &d, &x1), 4);
     assert_true(x1 == 0.1 * 1 + 1);
     free(text);
 }

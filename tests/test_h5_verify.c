@@ -39,10 +39,43 @@ static void test_verify_values(void **state)
     poke(f->path, "mode", 2, 1, H5T_NATIVE_INT8, &bad_mode);
     expect_damaged(f->path, "/mode row 2 column 1 is 77, not a mode");
 
-    uint8_t bad_event = 2;
+    uint8_t bad_event = 3;
     write_small(f->path, 0);
     poke(f->path, "event", 0, 0, H5T_NATIVE_UINT8, &bad_event);
-    expect_damaged(f->path, "/event row 0 is 2, not 0 or 1");
+    expect_damaged(f->path, "/event row 0 is 3, not 0, 1 or 2");
+}
+
+/* Two rows share a time only as a transition instant's before row (/event 2) and after row
+ * (/event 1), in that order. */
+static void test_verify_transition_pairs(void **state)
+{
+    output_fixture *f = *state;
+    bk_error err = {0};
+    uint8_t before = BK_ROW_BEFORE_TRANSITION, after = BK_ROW_AFTER_TRANSITION;
+    double zero = 0.0;
+    write_small(f->path, 0); /* rows at 0, 0.1, 0.2 s, all regular */
+    poke(f->path, "event", 0, 0, H5T_NATIVE_UINT8, &before);
+    poke(f->path, "event", 1, 0, H5T_NATIVE_UINT8, &after);
+    poke(f->path, "time", 1, 0, H5T_NATIVE_DOUBLE, &zero);
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+
+    write_small(f->path, 0); /* equal times, no pair */
+    poke(f->path, "time", 1, 0, H5T_NATIVE_DOUBLE, &zero);
+    expect_damaged(f->path, "/time is not strictly increasing at row 1");
+
+    write_small(f->path, 0); /* a before row followed by a later row */
+    poke(f->path, "event", 1, 0, H5T_NATIVE_UINT8, &before);
+    expect_damaged(f->path, "row 2 (t = 0.20000000000000001 s, /event 0) is not the after row");
+
+    write_small(f->path, 0); /* the pair in the wrong order */
+    poke(f->path, "event", 0, 0, H5T_NATIVE_UINT8, &after);
+    poke(f->path, "event", 1, 0, H5T_NATIVE_UINT8, &before);
+    poke(f->path, "time", 1, 0, H5T_NATIVE_DOUBLE, &zero);
+    expect_damaged(f->path, "/time is not strictly increasing at row 1");
+
+    write_small(f->path, 0); /* a before row last */
+    poke(f->path, "event", 2, 0, H5T_NATIVE_UINT8, &before);
+    expect_damaged(f->path, "the last row (/event 2) is a transition instant's before row");
 }
 
 static void test_verify_required_datasets(void **state)
@@ -179,6 +212,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         OUTPUT_TEST(test_verify_values),
+        OUTPUT_TEST(test_verify_transition_pairs),
         OUTPUT_TEST(test_verify_required_datasets),
         OUTPUT_TEST(test_verify_transitions),
         OUTPUT_TEST(test_verify_events),

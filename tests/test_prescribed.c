@@ -81,16 +81,22 @@ static void test_figure2(void **state)
     assert_int_equal(run_text(figure2, &r, &err), BK_OK);
     assert_close(r.t[r.n - 1], 0.42, 1e-12, 0);
     assert_close(r.x[r.n - 1], 6e-4, 1e-12, 0);
-    /* Rows at the two steps are the states just after them. */
+    /* Each step is two rows at one time, the states just before and just after it: slip and
+     * state continuous, the rate and the friction jumping. */
     size_t up = 0, down = 0;
     for (size_t i = 1; i < r.n; ++i) {
-        if (r.event[i] && r.v[i] > r.v[i - 1])
+        if (r.event[i] == BK_ROW_AFTER_TRANSITION && r.v[i] > r.v[i - 1])
             up = i;
-        if (r.event[i] && r.v[i] < r.v[i - 1])
+        if (r.event[i] == BK_ROW_AFTER_TRANSITION && r.v[i] < r.v[i - 1])
             down = i;
-        assert_true(r.t[i] > r.t[i - 1]);
+        if (r.event[i] == BK_ROW_AFTER_TRANSITION) {
+            assert_int_equal(r.event[i - 1], BK_ROW_BEFORE_TRANSITION);
+            assert_true(r.t[i] == r.t[i - 1] && r.x[i] == r.x[i - 1] && r.theta[i] == r.theta[i - 1]);
+        } else {
+            assert_true(r.t[i] > r.t[i - 1]);
+        }
     }
-    assert_true(up > 0 && down > up);
+    assert_true(up > 1 && down > up);
     double f_fast = exp(1000.0 * log1p(1e-2 / 100.0)), f_slow = exp(1000.0 * log1p(1e-3 / 100.0));
     double g_slow = (0.5 + 0.1 * exp(-1.0)) / f_slow;               /* at theta = L0 / 1 mm/s */
     double g_fast = (0.5 + 0.1 * exp(-pow(10.0, 1.2))) / f_fast;    /* at theta = L0 / 10 mm/s */
@@ -120,11 +126,15 @@ static void test_state_is_eq5(void **state)
     const double L0 = 2e-5, B = 4.6;
     double t_n = 0.0, theta_n = L0 / 1e-3;
     for (size_t i = 0; i < r.n; ++i) {
-        if (r.event[i] && i > 0) { /* a new segment: restart eq. 5 from here */
+        if (r.event[i] == BK_ROW_AFTER_TRANSITION) { /* a new segment: restart eq. 5 from here */
             t_n = r.t[i];
             theta_n = r.theta[i];
         }
         double v = r.v[i];
+        if (v == 0.0) { /* the block at rest before the first segment: the state it starts with */
+            assert_true(i == 0 && r.event[i] == BK_ROW_BEFORE_TRANSITION && r.theta[i] == theta_n);
+            continue;
+        }
         double expected = (theta_n - L0 / v) * exp(-(v / L0) * B * (r.t[i] - t_n)) + L0 / v;
         assert_close(r.theta[i], expected, 1e-12, 0);
     }

@@ -352,8 +352,8 @@ static void test_interrupt(void **state)
     bk_config_free(c);
 }
 
-/* Rows: one per sample time plus one per transition instant, strictly increasing in time,
- * the last at t_end. */
+/* Rows: one per sample time plus two per transition instant (before and after, at its
+ * time), otherwise strictly increasing in time, the last at t_end. */
 static void test_rows(void **state)
 {
     (void)state;
@@ -364,11 +364,96 @@ static void test_rows(void **state)
     bk_error err = {0};
     assert_int_equal(run_spec(&spec, &r, &stats, &err), BK_OK);
     assert_false(r.time_decreased);
-    assert_int_equal(r.rows, 501 + r.n_transitions);
+    assert_int_equal(r.before_rows, r.n_transitions); /* one block: one transition an instant */
+    assert_int_equal(r.after_rows, r.n_transitions);
+    assert_int_equal(r.rows, 501 + 2 * r.n_transitions);
     assert_int_equal(stats.rows, (long)r.rows);
     assert_close(r.last_t, 5.0, 0.0, 0.0);
     assert_close(stats.t_reached, 5.0, 0.0, 0.0);
     recorder_free(&r);
+}
+
+/* Block 0's rows and breakaways, as a reader of /cof and /transitions sees them. */
+typedef struct cof_rows {
+    double normal_force;      /* N */
+    double peak, peak_before; /* the largest /cof, and the largest of the before rows */
+    int last_kind;
+    double last_t;
+    long pairs, breakaways;
+    double breakaway_t, breakaway_cof; /* the last breakaway: its time and force / N */
+    double worst_breakaway;   /* the largest |before row's COF - force / N| at a breakaway */
+    int disorder;
+} cof_rows;
+
+static int keep_cof(void *self, const bk_sample *s, bk_error *err)
+{
+    (void)err;
+    cof_rows *r = self;
+    if (r->last_kind == BK_ROW_BEFORE_TRANSITION && (s->is_event != BK_ROW_AFTER_TRANSITION || s->t != r->last_t))
+        r->disorder = 1;
+    r->pairs += s->is_event == BK_ROW_AFTER_TRANSITION && r->last_kind == BK_ROW_BEFORE_TRANSITION;
+    r->peak = fmax(r->peak, s->cof[0]);
+    if (s->is_event == BK_ROW_BEFORE_TRANSITION) {
+        r->peak_before = fmax(r->peak_before, s->cof[0]);
+        if (s->t == r->breakaway_t)
+            r->worst_breakaway = fmax(r->worst_breakaway, fabs(s->cof[0] - r->breakaway_cof));
+    }
+    r->last_kind = s->is_event;
+    r->last_t = s->t;
+    return BK_OK;
+}
+
+/* An instant's transitions reach the sink before its two rows. */
+static int keep_breakaway(void *self, const bk_transition *t, bk_error *err)
+{
+    (void)err;
+    cof_rows *r = self;
+    if (t->from == BK_MODE_STICK) {
+        r->breakaways++;
+        r->breakaway_t = t->t;
+        r->breakaway_cof = fabs(t->force) / r->normal_force;
+    }
+    return BK_OK;
+}
+
+/* Every paper case's /cof shows its breakaways: the row just before each one holds the static
+ * threshold that gave way (the force in /transitions).  With Coulomb friction that is mu_s,
+ * the peak of /cof.  With rate-and-state friction the threshold mu(0, theta) heals towards
+ * mu_s during a stick, and while sliding the direct effect (1 + v/v0)^(1/m) lifts the
+ * friction above mu_s: there the peak is not mu_s, and the breakaways stay below it. */
+static void test_transition_rows_show_breakaway(void **state)
+{
+    (void)state;
+    static const char *const cases[] = {"a", "b", "c"};
+    static const char *const laws[] = {"coulomb", "rs"};
+    static const char *const springs[] = {"", "_tension_only"};
+    for (size_t c = 0; c < 3; ++c)
+        for (size_t l = 0; l < 2; ++l)
+            for (size_t sp = 0; sp < 2; ++sp) {
+                char path[128];
+                snprintf(path, sizeof path, "configs/paper/case_%s_%s%s.ini", cases[c], laws[l], springs[sp]);
+                bk_config *config = NULL;
+                bk_error err = {0};
+                assert_int_equal(bk_config_load_file(path, NULL, 0, &config, &err), BK_OK);
+                cof_rows r = {.normal_force = config->model->blocks[0].normal_force, .peak = -INFINITY,
+                              .peak_before = -INFINITY, .last_kind = -1, .breakaway_t = NAN};
+                bk_sink sink = {.self = &r, .sample = keep_cof, .transition = keep_breakaway};
+                assert_int_equal(bk_run(config, &sink, NULL, NULL, NULL, &err), BK_OK);
+                print_message("%s: peak /cof %.17g, before rows' peak %.17g, %ld pairs, %ld breakaways "
+                              "(before row - force / N: %.2g at most)\n",
+                              path, r.peak, r.peak_before, r.pairs, r.breakaways, r.worst_breakaway);
+                assert_false(r.disorder);
+                assert_true(r.breakaways >= 1 && r.pairs >= r.breakaways);
+                assert_true(r.worst_breakaway <= 1e-12);
+                if (l == 0) {
+                    assert_close(r.peak, 0.6, 1e-12, 0);
+                    assert_close(r.peak_before, 0.6, 1e-12, 0);
+                } else {
+                    assert_true(r.peak_before <= 0.6 * (1 + 1e-12));
+                    assert_true(r.peak > 0.6);
+                }
+                bk_config_free(config);
+            }
 }
 
 /* Any block can use any law; only blocks whose law has state carry state variables, and
@@ -646,6 +731,7 @@ int main(void)
         cmocka_unit_test(test_chattering_guard),
         cmocka_unit_test(test_interrupt),
         cmocka_unit_test(test_rows),
+        cmocka_unit_test(test_transition_rows_show_breakaway),
         cmocka_unit_test(test_per_block_laws),
         cmocka_unit_test(test_auto_method),
         cmocka_unit_test(test_distant_groups_independent),

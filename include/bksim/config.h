@@ -40,9 +40,10 @@ typedef struct bk_solver_options {
                                the method's own (Zonneveld 5_3_4, SDIRK 5_3_4) */
 } bk_solver_options;
 
-/* A full row at every transition instant costs (17 + 33 N) bytes for N blocks, against the
- * 38 of the transition record: cheap on short chains, where figures want it, an O(N)
- * snapshot per event on long ones.  event_rows = auto turns it on up to this many blocks. */
+/* The two full rows of a transition instant (before and after) cost 2 (17 + 33 N) bytes for
+ * N blocks, against the 38 of the transition record: cheap on short chains, where figures
+ * want them, an O(N) snapshot per event on long ones.  event_rows = auto turns them on up to
+ * this many blocks. */
 #define BK_EVENT_ROWS_AUTO_BLOCKS 16
 
 typedef struct bk_output_options {
@@ -52,7 +53,7 @@ typedef struct bk_output_options {
     int transitions;   /* write /transitions; default 1 */
     int events;        /* build the event catalog and write /events; default 1 (0 in a prescribed
                           scene) */
-    int event_rows;    /* add a row at every transition instant; default (auto): 1 for chains
+    int event_rows;    /* add two rows at every transition instant (bk_row_kind); default (auto): 1 for chains
                           of up to BK_EVENT_ROWS_AUTO_BLOCKS blocks, else 0 */
     double checkpoint_interval; /* s between checkpoints (restart points); 0 = none (default) */
     long max_rows;     /* sample rows t_end / interval may ask for; default 1e8 */

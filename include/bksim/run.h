@@ -27,8 +27,17 @@ typedef struct bk_sample {
     double elastic_energy;    /* J */
     double work_driver;       /* J, work done by the driver since t = 0 */
     double dissipation;       /* J, frictional dissipation since t = 0 */
-    int is_event;             /* 1 when this row is a transition instant (post-transition state) */
+    int is_event;             /* bk_row_kind */
 } bk_sample;
+
+/* What a row is.  A transition instant has two rows at the same time, the state just before
+ * its transitions and just after (x, v, energies and friction state are continuous there; the
+ * modes and the friction jump), so a series read row by row shows the jump and its peak. */
+typedef enum bk_row_kind {
+    BK_ROW_SAMPLE = 0,            /* a regular sample */
+    BK_ROW_AFTER_TRANSITION = 1,  /* a transition instant, the state just after it */
+    BK_ROW_BEFORE_TRANSITION = 2  /* the same instant just before it; the after row follows */
+} bk_row_kind;
 
 /* One block changing mode. */
 typedef struct bk_transition {

@@ -134,7 +134,7 @@ static int setup_export_series(hid_t file, const char *path, export_series *s, l
 static int parse_dataset_list(hid_t file, const char *path, const char *datasets,
                               export_series **out, size_t *count, bk_error *err)
 {
-    static const char *const defaults = "time,driver,x,v,friction,cof,mode";
+    static const char *const defaults = "time,event,driver,x,v,friction,cof,mode";
     bk_h5_name_list available;
     *out = NULL;
     *count = 0;

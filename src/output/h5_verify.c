@@ -30,8 +30,9 @@ static hsize_t scan_step(hid_t dset, hsize_t cols)
 }
 
 /* Every value of one time series, streamed a block of rows at a time: finite, modes and
- * event flags from their sets, /time strictly increasing up to t_reached (and t_end when
- * complete).  A chunk failing its checksum fails the read: damaged. */
+ * event flags from their sets, /time increasing up to t_reached (and t_end when complete),
+ * strictly but for the two rows of a transition instant (/event 2 then 1, at one time).  A
+ * chunk failing its checksum fails the read: damaged. */
 static int scan_series(hid_t file, const verify_ctx *v, const char *name, bk_error *err)
 {
     const char *path = v->path;
@@ -47,11 +48,22 @@ static int scan_series(hid_t file, const verify_ctx *v, const char *name, bk_err
     if (step > rows)
         step = rows ? rows : 1;
     double *buf = malloc((size_t)(step * cols) * sizeof *buf);
-    int rc = buf ? BK_OK : BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    /* /time is read with /event beside it: equal times are a transition instant's pair. */
+    hid_t event_dset = H5I_INVALID_HID;
+    hsize_t event_rows = 0, event_cols = 0;
+    int event_rank = 0;
+    double *kind = is_time ? malloc((size_t)step * sizeof *kind) : NULL;
+    int rc = buf && (!is_time || kind) ? BK_OK : BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    if (rc == BK_OK && is_time &&
+        (bk_h5_open_series(file, path, "event", &event_dset, &event_rows, &event_cols, &event_rank, err) != BK_OK ||
+         event_rows != rows || event_rank != 1))
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /event does not match /time", path);
     double prev = NAN, before = NAN; /* the value before this one; the block's last */
+    double prev_kind = NAN;
     for (hsize_t start = 0; rc == BK_OK && start < rows; start += step) {
         hsize_t count = rows - start < step ? rows - start : step;
-        if (bk_h5_read_block(dset, rank, start, count, 0, cols, H5T_NATIVE_DOUBLE, buf) < 0) {
+        if (bk_h5_read_block(dset, rank, start, count, 0, cols, H5T_NATIVE_DOUBLE, buf) < 0 ||
+            (is_time && bk_h5_read_block(event_dset, 1, start, count, 0, 1, H5T_NATIVE_DOUBLE, kind) < 0)) {
             rc = H5_DAMAGED(err, "%s: damaged: /%s rows %llu..%llu cannot be read", path, name,
                             (unsigned long long)start, (unsigned long long)(start + count - 1));
             break;
@@ -59,10 +71,16 @@ static int scan_series(hid_t file, const verify_ctx *v, const char *name, bk_err
         size_t values = (size_t)(count * cols);
         for (size_t k = 0; rc == BK_OK && k < values; ++k) {
             double x = buf[k];
+            int pair = is_time && prev_kind == BK_ROW_BEFORE_TRANSITION;
+            int in_order = !is_time || start + k == 0 ||
+                           (pair ? x == prev && kind[k] == BK_ROW_AFTER_TRANSITION : x > prev);
             int valid = is_mode    ? x == -1.0 || x == 0.0 || x == 1.0
-                        : is_event ? x == 0.0 || x == 1.0
-                                   : isfinite(x) && (!is_time || start + k == 0 || x > prev);
+                        : is_event ? x == BK_ROW_SAMPLE || x == BK_ROW_AFTER_TRANSITION ||
+                                         x == BK_ROW_BEFORE_TRANSITION
+                                   : isfinite(x) && in_order;
             prev = x;
+            if (is_time)
+                prev_kind = kind[k];
             if (valid)
                 continue;
             unsigned long long row = (unsigned long long)start + k / (size_t)cols;
@@ -76,11 +94,15 @@ static int scan_series(hid_t file, const verify_ctx *v, const char *name, bk_err
                 rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /mode %s is %g, not a mode "
                              "(stick 0, slip+ 1, slip- -1)", path, where, x);
             else if (is_event)
-                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /event %s is %g, not 0 or 1",
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /event %s is %g, not 0, 1 or 2",
                              path, where, x);
             else if (!isfinite(x))
                 rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s %s is %g, not finite", path,
                              name, where, x);
+            else if (pair)
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: row %llu (t = %.17g s, /event %g) is not "
+                             "the after row (/event 1, same time) of the before row %llu (t = %.17g s)",
+                             path, row, x, kind[k], row - 1, k ? buf[k - 1] : before);
             else
                 rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /time is not strictly increasing "
                              "at row %llu (%.17g after %.17g)", path, row, x, k ? buf[k - 1] : before);
@@ -88,9 +110,15 @@ static int scan_series(hid_t file, const verify_ctx *v, const char *name, bk_err
         before = buf[values - 1];
     }
     free(buf);
+    free(kind);
     bk_h5_close_id(dset);
+    if (event_dset != H5I_INVALID_HID)
+        bk_h5_close_id(event_dset);
     if (rc != BK_OK || !is_time)
         return rc;
+    if (rows > 0 && prev_kind == BK_ROW_BEFORE_TRANSITION)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: the last row (/event 2) is a transition "
+                       "instant's before row without its after row", path);
     if (rows > 0 && prev != v->t_reached)
         return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: t_reached (%.17g) is not the last time "
                        "(%.17g)", path, v->t_reached, prev);

@@ -503,7 +503,7 @@ static int sink_sample(void *self, const bk_sample *sample, bk_error *err)
     put_double(&s[BK_SERIES_TIME], sample->t);
     put_double(&s[BK_SERIES_DRIVER], sample->driver);
     if (s[BK_SERIES_EVENT].dset >= 0)
-        s[BK_SERIES_EVENT].buf[s[BK_SERIES_EVENT].buffered] = sample->is_event ? 1 : 0;
+        s[BK_SERIES_EVENT].buf[s[BK_SERIES_EVENT].buffered] = (unsigned char)sample->is_event;
     put_double(&s[BK_SERIES_EKIN], sample->kinetic_energy);
     put_double(&s[BK_SERIES_EEL], sample->elastic_energy);
     put_double(&s[BK_SERIES_WORK], sample->work_driver);

@@ -10,8 +10,8 @@ const bk_series_def bk_series[BK_N_SERIES] = {
     [BK_SERIES_TIME] = {"time", 0, BK_SHAPE_T, BK_KIND_F64, "s", "sample time"},
     [BK_SERIES_DRIVER] = {"driver", 0, BK_SHAPE_T, BK_KIND_F64, "m", "driver displacement D(t)"},
     [BK_SERIES_EVENT] = {"event", 0, BK_SHAPE_T, BK_KIND_U8, "1",
-                         "1 = row at a transition instant (post-transition state), 0 = regular "
-                         "sample"},
+                         "0 = regular sample; at a transition instant two rows with the same time: "
+                         "2 = the state just before its transitions, then 1 = just after"},
     [BK_SERIES_X] = {"x", BK_FIELD_X, BK_SHAPE_TN, BK_KIND_F64, "m",
                      "block displacement from the relaxed reference configuration"},
     [BK_SERIES_V] = {"v", BK_FIELD_V, BK_SHAPE_TN, BK_KIND_F64, "m/s", "block velocity"},

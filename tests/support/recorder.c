@@ -8,8 +8,13 @@ int record_sample(void *self, const bk_sample *s, bk_error *err)
 {
     (void)err;
     recorder *r = self;
-    if (r->rows > 0 && !(s->t > r->last_t))
+    /* Times increase, but for a transition instant's before and after rows (equal times). */
+    int pair = r->rows > 0 && r->last_kind == BK_ROW_BEFORE_TRANSITION;
+    if (r->rows > 0 && (pair ? s->t != r->last_t || s->is_event != BK_ROW_AFTER_TRANSITION : !(s->t > r->last_t)))
         r->time_decreased = 1;
+    r->last_kind = s->is_event;
+    r->before_rows += s->is_event == BK_ROW_BEFORE_TRANSITION;
+    r->after_rows += s->is_event == BK_ROW_AFTER_TRANSITION;
     if (r->rows == 0) {
         r->elastic0 = s->elastic_energy;
         r->kinetic0 = s->kinetic_energy;

@@ -14,7 +14,9 @@ typedef struct recorder {
     size_t n_transitions, cap_transitions;
     size_t rows;
     double last_t;
-    int time_decreased;
+    int last_kind;               /* bk_row_kind of the last row */
+    size_t before_rows, after_rows; /* of transition instants (bk_row_kind) */
+    int time_decreased;          /* or equal, other than at a transition instant's two rows */
     int non_finite;              /* a row had a non-finite x, v or friction */
     const exact_solution *exact; /* when set: track block 0's position error at every row */
     double max_position_error;   /* m, over all rows */
