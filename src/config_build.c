@@ -441,10 +441,21 @@ bk_config *bk_config_build(loader *ld)
     double event_rows = value_of(ld, "output", "event_rows");
     o->event_rows = isnan(event_rows) ? c->model && c->model->n_blocks <= BK_EVENT_ROWS_AUTO_BLOCKS
                                       : (int)event_rows;
-    o->checkpoint_interval = value_of(ld, "output", "checkpoint_interval");
+    /* Restart points where the run's own time or work says, the same in every run of a config,
+     * so that whether the wall clock had a checkpoint written at one never changes a result. */
     entry *checkpoints = bk_config_lookup(ld, "output", "checkpoint_interval");
+    entry *work = bk_config_lookup(ld, "output", "checkpoint_work");
+    o->checkpoint_interval = checkpoints ? checkpoints->number : 0.0;
     if (c->prescribed && checkpoints && o->checkpoint_interval > 0.0)
         bk_config_report_entry(ld, checkpoints, "a prescribed scene has no dynamics to checkpoint (allowed: 0)");
+    if (work && checkpoints)
+        bk_config_report_entry(ld, work, "applies only with checkpoint_interval = auto (not set); "
+                               "checkpoint_interval = %s is given", checkpoints->value);
+    double blocks = c->model ? (double)c->model->n_blocks : 1.0;
+    if (!checkpoints && !c->prescribed)
+        o->checkpoint_work = work ? work->number : BK_CHECKPOINT_WORK + BK_CHECKPOINT_WORK_PER_BLOCK * blocks;
+    entry *wall = bk_config_lookup(ld, "output", "checkpoint_wall_interval");
+    o->checkpoint_wall_interval = wall ? wall->number : checkpoints ? 0.0 : BK_CHECKPOINT_WALL_INTERVAL;
     o->max_rows = (long)value_of(ld, "output", "max_rows");
     double samples = o->interval > 0.0 ? c->t_end / o->interval : 0.0;
     if (samples > (double)o->max_rows) {

@@ -65,10 +65,22 @@ int bk_run_report_progress(run_ctx *ctx, double t)
 
 double bk_run_checkpoint_time(const run_ctx *ctx)
 {
-    if (ctx->checkpoint_interval <= 0.0)
-        return INFINITY;
-    double t = (double)ctx->next_checkpoint * ctx->checkpoint_interval;
+    double t = ctx->checkpoint_interval > 0.0 ? (double)ctx->next_checkpoint * ctx->checkpoint_interval
+                                              : ctx->t_restart;
     return t < ctx->t_end ? t : INFINITY;
+}
+
+/* An automatic restart point once the work since the last one reaches checkpoint_work: on a
+ * fine grid of time just after everything settled so far, so that every island's last step
+ * ends there or contains it.  Work and times are the run's own, the same in every run of the
+ * config, so a resumed run restarts where the uninterrupted one does. */
+static void plan_restart(run_ctx *ctx)
+{
+    if (!(ctx->checkpoint_work > 0.0) || ctx->restart_work < ctx->checkpoint_work || isfinite(ctx->t_restart))
+        return;
+    double grid = ctx->t_end * 0x1p-20;
+    double t = (floor(ctx->t_settled / grid) + 1.0) * grid;
+    ctx->t_restart = t > ctx->t_settled ? t : ctx->t_settled + grid;
 }
 
 double bk_run_stop_time(const run_ctx *ctx)
@@ -126,6 +138,7 @@ enum action { STEP, EVENT, QUIET, SAMPLE, STOP };
 static int schedule(run_ctx *ctx)
 {
     for (;;) {
+        plan_restart(ctx);
         double t_sample = ctx->next_sample >= 0 ? sample_time(ctx, ctx->next_sample) : INFINITY;
         double t_stop = bk_run_stop_time(ctx);
         double t_barrier = t_sample < t_stop ? t_sample : t_stop;
@@ -166,6 +179,7 @@ static int schedule(run_ctx *ctx)
             continue; /* the row may have taken the sample */
         }
         int rc = BK_OK;
+        ctx->t_settled = t_action;
         switch (action) {
         case STEP:
             rc = bk_run_island_step(ctx, id);
@@ -327,6 +341,10 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
     ctx.cpu0 = (double)cpu0;
     ctx.checkpoint_interval = config->output.checkpoint_interval;
     ctx.next_checkpoint = 1;
+    ctx.checkpoint_wall_interval = config->output.checkpoint_wall_interval;
+    ctx.wall_checkpoint = wall0;
+    ctx.checkpoint_work = config->output.checkpoint_work;
+    ctx.t_restart = INFINITY;
     ctx.t_row_due = NAN;
     ctx.max_bytes = config->output.max_bytes > 0.0 ? config->output.max_bytes : INFINITY;
     ctx.row_bytes = bk_output_row_bytes(config->output.fields, config->model->n_blocks,
@@ -376,7 +394,7 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
         goto done;
 
     if (from) {
-        ctx.t_resumed = ctx.t_progress = from->t;
+        ctx.t_resumed = ctx.t_progress = ctx.t_settled = from->t;
         if ((rc = bk_run_resume(&ctx, from)) != BK_OK || (rc = bk_run_partition_all(&ctx, from->t)) != BK_OK)
             goto done;
     } else {

@@ -54,7 +54,7 @@ int bk_run_catalog_init(run_ctx *ctx, const bk_checkpoint *from)
     }
     if (!ctx->catalog || !ctx->rate_v || !ctx->rate_a || (creeping && !scene->above))
         return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the event catalog of %zu blocks", n);
-    if (ctx->checkpoint_interval > 0.0) {
+    if (ctx->checkpoint_interval > 0.0 || ctx->checkpoint_work > 0.0) {
         bk_catalog_state *s = &ctx->catalog_state;
         s->x_onset = malloc(n * sizeof *s->x_onset);
         s->first_force = malloc(n * sizeof *s->first_force);

@@ -112,9 +112,16 @@ typedef struct run_ctx {
     double wall_start;    /* s, monotonic clock at the start */
     double cpu0;          /* clock() at the start */
 
-    /* Checkpoints: forced restarts at multiples of the interval. */
+    /* Restart points, at multiples of checkpoint_interval or (when it is automatic) after
+     * checkpoint_work units of work; written as checkpoints when the wall clock says. */
     double checkpoint_interval;
     long next_checkpoint; /* index k of the next checkpoint time k * interval */
+    double checkpoint_work;          /* 0: restart points by the interval, or none */
+    double restart_work;             /* block-steps, transitions and row blocks since the last */
+    double t_restart;                /* s, the next automatic restart point; +inf: not yet due */
+    double t_settled;                /* s, the time of the scheduler's last action */
+    double checkpoint_wall_interval; /* s: write a restart point once this has passed */
+    double wall_checkpoint;          /* s, monotonic clock at the last one written (or the start) */
     bk_run_stats base;    /* counters of the run this one resumed, if any */
 
     /* The event catalog (run_catalog.c); NULL when the run keeps none. */
@@ -214,8 +221,8 @@ void bk_run_enter_stuck(run_ctx *ctx, size_t i, double t);
 void bk_run_energy_totals(run_ctx *ctx, double t, double island_work, double island_dissipation);
 /* Statistics so far, the resumed run's included. */
 void bk_run_collect_stats(const run_ctx *ctx, bk_run_stats *stats, double cpu0);
-/* The state at a checkpoint time t (islands stopped there): recorded, then every island
- * restarted, as a resumed run will. */
+/* The state at a checkpoint time t (islands stopped there): recorded when the wall-clock
+ * interval has passed, then every island restarted, as a resumed run will, written or not. */
 int bk_run_checkpoint(run_ctx *ctx, double t);
 /* The state of a checkpoint, back into the chain. */
 int bk_run_resume(run_ctx *ctx, const bk_checkpoint *cp);

@@ -603,6 +603,7 @@ int bk_run_island_step(run_ctx *ctx, size_t id)
         return step;
     isl->stepped = 1;
     isl->t_reached = t_reached;
+    ctx->restart_work += (double)isl->island.len;
     int rc = check_finite(ctx, isl, t_reached);
     if (rc != BK_OK)
         return rc;

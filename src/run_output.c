@@ -63,6 +63,7 @@ static int send_row(run_ctx *ctx, double t, bk_row_kind kind)
     ctx->t_last_row = t;
     ctx->steps_since_row = 0;
     ctx->stats->rows++;
+    ctx->restart_work += (double)ctx->scene.n;
     if (ctx->sink && ctx->sink->sample) {
         int rc = ctx->sink->sample(ctx->sink->self, &sample, ctx->err);
         if (rc != BK_OK)
@@ -134,6 +135,7 @@ int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_
                        bk_scene_static_threshold(scene, i));
     ctx->stats->transitions++;
     ctx->steps_since_row = 0;
+    ctx->restart_work += 1.0;
     if (ctx->mode_before && ctx->mode_before[i] == BK_MODE_UNCHANGED) {
         ctx->mode_before[i] = (int8_t)from;
         ctx->changed[ctx->n_changed++] = i;
@@ -250,7 +252,11 @@ int bk_run_checkpoint(run_ctx *ctx, double t)
         return rc;
     bk_run_rebase_energy(ctx, t);
     ctx->next_checkpoint++;
-    if (ctx->sink && ctx->sink->checkpoint) {
+    ctx->restart_work = 0.0;
+    ctx->t_restart = INFINITY;
+    double now = bk_run_wall_seconds();
+    if (ctx->sink && ctx->sink->checkpoint && now - ctx->wall_checkpoint >= ctx->checkpoint_wall_interval) {
+        ctx->wall_checkpoint = now;
         bk_scene *scene = &ctx->scene;
         bk_checkpoint cp = {
             .t = t,

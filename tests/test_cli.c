@@ -1042,6 +1042,81 @@ static void test_sigkill_restart_loop(void **state)
     assert_true(finished_by_restart >= 2);
 }
 
+static double seconds_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* A run with the default checkpoint settings, scaled down (restart points every 2e4 units of
+ * work instead of 1e7, some 45 in the run; the wall-clock interval a quarter of the run),
+ * writes a checkpoint once that interval has passed; killed then and restarted, it ends with
+ * the very output of an uninterrupted run that wrote no checkpoint at all: the restart
+ * points are where the run's own work puts them, the same in every run, and the wall clock
+ * only decides which of them are written. */
+static void test_wall_clock_checkpoint(void **state)
+{
+    (void)state;
+    /* A chain of 10: chaotic, so any perturbation of a restart would show in every dataset. */
+    const char *scene = "configs/chains/bk10_coulomb.ini --quiet --set run.t_end=20 --set output.checkpoint_work=2e4";
+    char reference[512], out[512], cmd[2048], *text = NULL;
+    snprintf(reference, sizeof reference, "%s/wall_reference.h5", tmpdir);
+    snprintf(out, sizeof out, "%s/wall_killed.h5", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s", scene, reference);
+    double t0 = seconds_now();
+    assert_int_equal(run_command(cmd, NULL), 0);
+    double wall = seconds_now() - t0;
+    hid_t file = H5Fopen(reference, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(file >= 0);
+    assert_true(H5Lexists(file, "checkpoint", H5P_DEFAULT) == 0); /* 300 s never passed */
+    H5Fclose(file);
+
+    double interval = 0.25 * wall;
+    snprintf(cmd, sizeof cmd, "./bksim run %s --set output.checkpoint_wall_interval=%.3f -o %s "
+             "> /dev/null 2>&1 & echo $!", scene, interval, out);
+    t0 = seconds_now();
+    assert_int_equal(run_command(cmd, &text), 0);
+    long pid = strtol(text, NULL, 10);
+    free(text);
+    assert_true(pid > 0);
+    int written = 0;
+    snprintf(cmd, sizeof cmd, "./bksim info %s.part", out);
+    for (int tries = 0; tries < 2000 && !written; ++tries) {
+        nanosleep(&(struct timespec){0, 5000000L}, NULL);
+        run_command(cmd, &text);
+        written = strstr(text, "checkpoint   t = ") != NULL;
+        free(text);
+    }
+    double killed_after = seconds_now() - t0;
+    snprintf(cmd, sizeof cmd, "kill -KILL %ld", pid);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    print_message("run of %.2f s, wall-clock interval %.3f s: killed %.3f s in, after its first checkpoint\n",
+                  wall, interval, killed_after);
+    assert_true(written);
+    assert_true(killed_after >= interval);
+    /* Dead once the file is no longer locked (a zombie may linger, unreaped). */
+    snprintf(cmd, sizeof cmd, "./bksim info %s.part", out);
+    int status = 3;
+    for (int tries = 0; tries < 1000; ++tries) {
+        status = run_command(cmd, &text);
+        int running = strstr(text, "in progress") != NULL;
+        free(text);
+        if (!running)
+            break;
+        nanosleep(&(struct timespec){0, 5000000L}, NULL);
+    }
+    assert_int_equal(status, 3);
+    double t_checkpoint = 0.0;
+    bk_error err = {0};
+    assert_int_equal(bk_h5_restartable(out, &t_checkpoint, &err), 1);
+    assert_true(t_checkpoint > 0.0 && t_checkpoint < 20.0);
+    snprintf(cmd, sizeof cmd, "./bksim run --restart %s.part --quiet", out);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    assert_same_output(reference, out);
+    assert_int_equal(bk_h5_verify(out, &err), BK_OK);
+}
+
 static void test_restart_errors(void **state)
 {
     (void)state;
@@ -1052,7 +1127,8 @@ static void test_restart_errors(void **state)
              "./bksim run configs/paper/case_b_coulomb.ini -o %s -q --set run.wall_time_limit=1e-4", out);
     assert_int_equal(run_command(cmd, NULL), 1);
     snprintf(cmd, sizeof cmd, "./bksim run --restart %s.part", out);
-    expect_command(cmd, 2, "no checkpoint to restart from (run with [output] checkpoint_interval > 0)");
+    expect_command(cmd, 2, "no checkpoint to restart from (a run writes its first once [output] "
+                           "checkpoint_wall_interval has passed, 300 s by default");
     snprintf(cmd, sizeof cmd, "./bksim run configs/paper/case_a_coulomb.ini -q -o %s/finished.h5 "
                               "--set output.checkpoint_interval=1 && ./bksim run --restart %s/finished.h5",
              tmpdir, tmpdir);
@@ -1248,6 +1324,7 @@ int main(void)
         cmocka_unit_test(test_limits),
         cmocka_unit_test(test_restart_equivalence),
         cmocka_unit_test(test_sigkill_restart_loop),
+        cmocka_unit_test(test_wall_clock_checkpoint),
         cmocka_unit_test(test_restart_errors),
         cmocka_unit_test(test_catalog_scripts),
         cmocka_unit_test(test_bench_smoke),

@@ -125,7 +125,39 @@ static void test_defaults(void **state)
     assert_int_equal(c->output.fields, BK_FIELD_ALL);
     assert_int_equal(c->output.transitions, 1);
     assert_int_equal(c->output.event_rows, 1); /* auto: a short chain gets event rows */
+    /* Restart points by work, written by the wall clock. */
+    assert_close(c->output.checkpoint_interval, 0.0, 0, 0);
+    assert_close(c->output.checkpoint_work, BK_CHECKPOINT_WORK + BK_CHECKPOINT_WORK_PER_BLOCK, 0, 0);
+    assert_close(c->output.checkpoint_wall_interval, BK_CHECKPOINT_WALL_INTERVAL, 0, 0);
     bk_config_free(c);
+}
+
+/* An interval given in simulated time writes every restart point unless a wall-clock interval
+ * is given too; 0 turns restart points off altogether. */
+static void test_checkpoint_keys(void **state)
+{
+    (void)state;
+    const struct {
+        const char *overrides[2];
+        double interval, work, wall;
+    } cases[] = {
+        {{"output.checkpoint_interval=0.5", NULL}, 0.5, 0.0, 0.0},
+        {{"output.checkpoint_interval=0.5", "output.checkpoint_wall_interval=60"}, 0.5, 0.0, 60.0},
+        {{"output.checkpoint_interval=0", NULL}, 0.0, 0.0, 0.0},
+        {{"output.checkpoint_work=2e4", NULL}, 0.0, 2e4, BK_CHECKPOINT_WALL_INTERVAL},
+        {{"model.n_blocks=1000", NULL}, 0.0, BK_CHECKPOINT_WORK + 1000 * BK_CHECKPOINT_WORK_PER_BLOCK,
+         BK_CHECKPOINT_WALL_INTERVAL},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; ++k) {
+        bk_config *c = NULL;
+        bk_error err = {0};
+        size_t n = cases[k].overrides[1] ? 2 : 1;
+        assert_int_equal(bk_config_load_string(minimal_config, "cp.ini", cases[k].overrides, n, &c, &err), BK_OK);
+        assert_close(c->output.checkpoint_interval, cases[k].interval, 0, 0);
+        assert_close(c->output.checkpoint_work, cases[k].work, 0, 0);
+        assert_close(c->output.checkpoint_wall_interval, cases[k].wall, 0, 0);
+        bk_config_free(c);
+    }
 }
 
 /* event_rows = auto (the default, or by name) writes full rows at transitions on chains of
@@ -253,6 +285,11 @@ static void test_rejections(void **state)
          "t.ini:15: [output] fields: unknown field \"speed\" (allowed: all, or a list of x, v, friction, cof, mode, energy, state)"},
         {"t_end = 5\n", "t_end = 5\n[output]\ninterval = 6\n", "t.ini:15: [output] interval: must be <= t_end (5 s), got 6"},
         {"t_end = 5\n", "t_end = 5\n[output]\npath =\n", "t.ini:15: [output] path: empty value"},
+        {"t_end = 5\n", "t_end = 5\n[output]\ncheckpoint_interval = 1\ncheckpoint_work = 1e4\n",
+         "t.ini:16: [output] checkpoint_work: applies only with checkpoint_interval = auto (not set); "
+         "checkpoint_interval = 1 is given"},
+        {"t_end = 5\n", "t_end = 5\n[output]\ncheckpoint_work = 0\n",
+         "t.ini:15: [output] checkpoint_work: out of range, got 0 (allowed: 0 < checkpoint_work < inf)"},
         {"velocity = 1e-3\n", "velocity = 1e-3\nspring = elastic\n",
          "t.ini:12: [driver] spring: unknown value \"elastic\" (allowed: linear, tension_only)"},
         {"mass = 1\n", "mass = 1\n[block.1]\nmass = 2\n", "t.ini:5: [block.1]: block index out of range (allowed: 0..0)"},
@@ -557,6 +594,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_full_config),
         cmocka_unit_test(test_defaults),
+        cmocka_unit_test(test_checkpoint_keys),
         cmocka_unit_test(test_event_rows_auto),
         cmocka_unit_test(test_tolerated_forms),
         cmocka_unit_test(test_rejections),

@@ -46,6 +46,15 @@ typedef struct bk_solver_options {
  * this many blocks. */
 #define BK_EVENT_ROWS_AUTO_BLOCKS 16
 
+/* s: by default a run writes a checkpoint about this often, so that any run longer than this
+ * can be continued (REBOUND's simulation archives do the same by wall time). */
+#define BK_CHECKPOINT_WALL_INTERVAL 300.0
+/* Work between automatic restart points: a few seconds of CPU (a unit costs 0.2-0.6 us), and
+ * per block 300 times the few units a restart of every integrator costs, so restarts add under
+ * 1 % to a run and nothing to one that never does this much work. */
+#define BK_CHECKPOINT_WORK 1e7
+#define BK_CHECKPOINT_WORK_PER_BLOCK 300.0
+
 typedef struct bk_output_options {
     char *path;        /* HDF5 output path, owned; default "<config stem>.h5" */
     double interval;   /* s between samples; 0 = transition rows only; default t_end/1000 */
@@ -55,7 +64,18 @@ typedef struct bk_output_options {
                           scene) */
     int event_rows;    /* add two rows at every transition instant (bk_row_kind); default (auto): 1 for chains
                           of up to BK_EVENT_ROWS_AUTO_BLOCKS blocks, else 0 */
-    double checkpoint_interval; /* s between checkpoints (restart points); 0 = none (default) */
+    double checkpoint_interval; /* s of simulated time between restart points, where a checkpoint
+                                   may be written; 0 = none, or automatic by checkpoint_work
+                                   (the default) */
+    double checkpoint_work;     /* restart points after this much work (blocks advanced by
+                                   integrator steps, transitions, blocks written in rows); 0 =
+                                   by checkpoint_interval; default BK_CHECKPOINT_WORK +
+                                   BK_CHECKPOINT_WORK_PER_BLOCK n_blocks */
+    double checkpoint_wall_interval; /* s of wall-clock time: a restart point is written as a
+                                        checkpoint once this has passed since the last one (or
+                                        the start); 0 = every one; default
+                                        BK_CHECKPOINT_WALL_INTERVAL, 0 when checkpoint_interval
+                                        is given */
     long max_rows;     /* sample rows t_end / interval may ask for; default 1e8 */
     double max_bytes;  /* bytes the rows and transitions may take on disk: the sample rows
                           checked at load, everything written checked during the run;

@@ -500,10 +500,16 @@ static int cmd_run(int argc, char **argv)
             fprintf(stderr, "bksim: partial output left in %s.part (complete = 0); continue it from "
                             "its checkpoint t = %.17g s with `bksim run --restart %s.part`\n",
                     path, t_checkpoint, path);
+        else if (config->output.checkpoint_interval > 0.0 || config->output.checkpoint_work > 0.0)
+            fprintf(stderr, "bksim: partial output left in %s.part (complete = 0); it holds no "
+                            "checkpoint, so it cannot be continued: running again starts over (the "
+                            "run writes its first at the restart point after [output] "
+                            "checkpoint_wall_interval = %g s)\n",
+                    path, config->output.checkpoint_wall_interval);
         else
             fprintf(stderr, "bksim: partial output left in %s.part (complete = 0); it holds no "
-                            "checkpoint, so it cannot be continued: running again starts over "
-                            "([output] checkpoint_interval makes checkpoints)\n",
+                            "checkpoint ([output] checkpoint_interval = 0), so it cannot be "
+                            "continued: running again starts over\n",
                     path);
         status = EXIT_RUN_FAILED;
     } else if (bk_h5_writer_finish(writer, &stats, &err) != BK_OK) {

@@ -417,8 +417,9 @@ int bk_h5_find_checkpoint(hid_t file, const char *path, size_t n_blocks, bk_h5_s
 {
     memset(slot, 0, sizeof *slot);
     if (H5Lexists(file, "checkpoint", H5P_DEFAULT) <= 0)
-        return BK_FAIL(err, BK_ERR_INVALID, "%s: no checkpoint to restart from (run with [output] "
-                       "checkpoint_interval > 0)", path);
+        return BK_FAIL(err, BK_ERR_INVALID, "%s: no checkpoint to restart from (a run writes its first "
+                       "once [output] checkpoint_wall_interval has passed, %g s by default, unless "
+                       "checkpoint_interval = 0)", path, BK_CHECKPOINT_WALL_INTERVAL);
     hid_t top = H5Gopen2(file, "checkpoint", H5P_DEFAULT);
     if (top < 0)
         return H5_DAMAGED(err, "%s: damaged: /checkpoint cannot be opened", path);
