@@ -34,6 +34,7 @@ void bk_config_free(bk_config *config)
     for (size_t k = 0; k < config->n_overrides; ++k)
         free(config->overrides[k]);
     free(config->overrides);
+    bk_config_free_parameters(config->parameters, config->n_parameters);
     free(config);
 }
 
@@ -42,9 +43,11 @@ static void free_loader(loader *ld)
     for (size_t i = 0; i < ld->n; ++i) {
         free(ld->entries[i].value);
         free(ld->entries[i].list);
+        bk_config_free_draws(&ld->entries[i]);
     }
     free(ld->entries);
     free(ld->slots);
+    bk_config_free_parameters(ld->parameters, ld->n_parameters);
 }
 
 /* Strip surrounding whitespace in place. */

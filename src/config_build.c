@@ -41,7 +41,7 @@ static double value_of(loader *ld, const char *section, const char *key)
     return def->param.default_value;
 }
 
-/* A block key: [block.I] over [block] over the default. */
+/* A block key: [block.I] over [block] over the default; a distribution draws block i's. */
 static double block_value(loader *ld, size_t i, const char *key, int *given)
 {
     char section[SECTION_LEN];
@@ -49,8 +49,11 @@ static double block_value(loader *ld, size_t i, const char *key, int *given)
     entry *e = bk_config_lookup(ld, section, key);
     if (!e)
         e = bk_config_lookup(ld, "block", key);
+    const bk_param *param = &bk_config_find_key("block", key)->param;
     *given = e != NULL;
-    return e ? e->number : bk_config_find_key("block", key)->param.default_value;
+    double value = !e ? param->default_value : e->distribution ? bk_config_draw(ld, e, i, param) : e->number;
+    bk_config_record_parameter(ld, "block", key, param->unit, i, value);
+    return value;
 }
 
 /* Friction of block i: its law and parameters, completed and validated. */
@@ -81,7 +84,8 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
             e = bk_config_lookup(ld, "friction", param->key);
         origin[p] = e;
         if (e) {
-            b->friction_params[p] = e->number;
+            b->friction_params[p] = e->distribution ? bk_config_draw(ld, e, i, param) : e->number;
+            bk_config_record_parameter(ld, "friction", param->key, param->unit, i, b->friction_params[p]);
         } else if (param->flags & BK_PARAM_REQUIRED) {
             report_missing(ld, param_section, param, NULL);
             b->friction_params[p] = NAN;
@@ -121,6 +125,8 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
                         block_note[0] = '\0';
                     break;
                 }
+            if (at && at->distribution && !block_note[0])
+                snprintf(block_note, sizeof block_note, " (drawn for block %zu)", i);
             if (at)
                 bk_config_report_entry(ld, at, "%s%s", msg, block_note);
             else
@@ -208,6 +214,11 @@ static void build_chain(loader *ld, bk_config *c)
     m->driver.start_position = value_of(ld, "driver", "start_position");
 
     static const char *const required[] = {"mass", "driver_stiffness"};
+    ld->seed = (unsigned long)value_of(ld, "model", "seed");
+    if (bk_config_plan_parameters(ld, n) != 0) {
+        bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+        return;
+    }
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
     if (!rng) {
         bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
@@ -309,6 +320,11 @@ static void build_prescribed(loader *ld, bk_config *c)
     }
     m->gravity = value_of(ld, "model", "gravity");
     m->driver.velocity = first_rate;
+    ld->seed = (unsigned long)value_of(ld, "model", "seed");
+    if (bk_config_plan_parameters(ld, 1) != 0) {
+        bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+        return;
+    }
     bk_block *b = &m->blocks[0];
     int given_mass, given_normal;
     double mass = block_value(ld, 0, "mass", &given_mass);
@@ -404,6 +420,10 @@ bk_config *bk_config_build(loader *ld)
         build_prescribed(ld, c);
     else
         build_chain(ld, c);
+    c->parameters = ld->parameters;
+    c->n_parameters = ld->n_parameters;
+    ld->parameters = NULL;
+    ld->n_parameters = 0;
 
     bk_solver_options *s = &c->solver;
     snprintf(s->method, sizeof s->method, "%s", bk_config_method_name((size_t)value_of(ld, "solver", "method")));

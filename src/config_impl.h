@@ -48,6 +48,12 @@ typedef struct entry {
     long first_of_key;         /* an earlier file entry of the same section and key, or -1 */
     double number;             /* parsed value (numbers, bools, enum index, list length) */
     double *list;              /* BK_KEY_LIST values, owned */
+    /* A value drawn per block (config_random.c): 1 uniform, 2 normal, 3 lognormal; 0 none. */
+    int distribution;
+    double dist_a, dist_b;
+    void *rng;                 /* the entry's stream (gsl_rng), owned */
+    size_t drawn;              /* numbers drawn so far, and the last */
+    double last_draw;
 } entry;
 
 typedef struct loader {
@@ -66,6 +72,9 @@ typedef struct loader {
      * and a config with many [block.I] sections loads in linear time. */
     size_t *slots;             /* entry index + 1, 0 for an empty slot */
     size_t n_slots;            /* a power of two, at least twice the entries */
+    unsigned long seed;        /* [model] seed, once building begins */
+    bk_block_parameter *parameters; /* keys given as a distribution, until the config takes them */
+    size_t n_parameters;
 } loader;
 
 /* Ranks put errors in the order a user fixes them: 0 (out of memory) first, then file lines,
@@ -86,6 +95,21 @@ int bk_config_build_index(loader *ld);
 entry *bk_config_lookup(loader *ld, const char *section, const char *key);
 int bk_config_check_value(loader *ld, entry *e, const key_def *def, const bk_param *param);
 void bk_config_check_entries(loader *ld, long n_blocks);
+
+/* --- per-block random values (config_random.c) ----------------------------------------- */
+
+/* 1 and the entry set up when its value is a distribution, 0 when it is none, -1 reported. */
+int bk_config_parse_distribution(loader *ld, entry *e, const bk_param *param, const char *allowed);
+/* The entry's value for block i, drawn (blocks in increasing order); NAN, reported, when the
+ * draw falls outside param's range. */
+double bk_config_draw(loader *ld, entry *e, size_t block, const bk_param *param);
+void bk_config_free_draws(entry *e);
+/* A /parameters array for every key some entry draws; the values blocks end with go in by
+ * bk_config_record_parameter (a key without an array is ignored). */
+int bk_config_plan_parameters(loader *ld, size_t n_blocks);
+void bk_config_record_parameter(loader *ld, const char *base, const char *key, const char *unit, size_t block,
+                                double value);
+void bk_config_free_parameters(bk_block_parameter *parameters, size_t n);
 
 /* --- building (config_build.c) ---------------------------------------------------------- */
 

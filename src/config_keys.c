@@ -51,7 +51,7 @@ static const key_def keys[] = {
     NUM("model", "gravity", "m/s^2", 9.81, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
         "gravitational acceleration, for the default normal force"),
     INT("model", "seed", 1, 0, 4294967295.0, 0,
-        "seed of the random numbers drawn at load time (x_init_random); same seed, same run"),
+        "seed of the random numbers drawn at load time (x_init_random, distributions); same seed, same run"),
 
     NUM("block", "mass", "kg", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE, "block mass"),
     NUM("block", "driver_stiffness", "N/m", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED,
@@ -259,9 +259,14 @@ void bk_config_write_reference(FILE *out)
 {
     static const char *const notes[] = {
         "model", "The chain.",
-        "block", "Defaults for every block; a `[block.I]` section (I = 0 .. n_blocks-1) overrides them for block I.",
+        "block", "Defaults for every block; a `[block.I]` section (I = 0 .. n_blocks-1) overrides them for block I. "
+                 "Any numeric key here or in `[friction]` may be a distribution drawn per block at load time from "
+                 "`[model] seed`: `uniform(a, b)`, `normal(mean, sd)` or `lognormal(mu, sigma)` (of the log); a draw "
+                 "outside the key's range is an error naming the block, and every block's value is written to "
+                 "`/parameters/<section>.<key>`.",
         "friction", "The friction law of every block and its parameters (tables below); `[friction.I]` overrides "
-                    "them for block I. A `[friction.I]` naming a different law takes none of `[friction]`'s parameters.",
+                    "them for block I. A `[friction.I]` naming a different law takes none of `[friction]`'s "
+                    "parameters. Numeric parameters may be distributions, as in `[block]`.",
         "driver", "The driver that pulls every block through its driver spring.",
         "solver", "Integration.",
         "output", "The HDF5 file.",

@@ -267,6 +267,9 @@ int bk_config_check_value(loader *ld, entry *e, const key_def *def, const bk_par
     switch (type) {
     case BK_KEY_NUMBER:
     case BK_KEY_INTEGER: {
+        int drawn = type == BK_KEY_NUMBER ? bk_config_parse_distribution(ld, e, param, allowed) : 0;
+        if (drawn != 0)
+            return drawn < 0 ? -1 : 0;
         int bad = type == BK_KEY_INTEGER ? parse_integer(v, &e->number) : parse_number(v, &e->number);
         if (bad) {
             const char *hint = strchr(v, '#') ? " (inline comments start with ';')" : "";

@@ -436,6 +436,28 @@ static void test_every_key_rejects_bad_values(void **state)
     assert_true(keys > 50 && rejected > 5 * keys);
 }
 
+/* A distribution's bad input through the CLI: file:line, exit 2, no output file. */
+static void test_distribution_errors(void **state)
+{
+    (void)state;
+    const struct {
+        const char *set, *message;
+    } cases[] = {
+        {"friction.mu_s=normal(0.6, -0.01)", "[friction] mu_s: normal(0.6, -0.01) has a negative width (allowed: sd >= 0)"},
+        {"block.mass=uniform(2, 1)", "[block] mass: uniform(2, 1) has a negative width (allowed: a <= b)"},
+        {"block.mass=normal(0.01, 1)", "for block "},
+        {"driver.velocity=uniform(1e-3, 2e-3)", "[driver] velocity: a distribution is drawn per block"},
+    };
+    char out[512], cmd[2048];
+    snprintf(out, sizeof out, "%s/drawn.h5", tmpdir);
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; ++k) {
+        snprintf(cmd, sizeof cmd, "./bksim run configs/chains/bk10_coulomb.ini -o %s --set '%s'", out, cases[k].set);
+        expect_command(cmd, 2, cases[k].message);
+        expect_command(cmd, 2, "--set ");
+        assert_false(path_exists(out));
+    }
+}
+
 /* --- the other commands ---------------------------------------------------------------- */
 
 static void test_commands(void **state)
@@ -1310,6 +1332,7 @@ int main(void)
         cmocka_unit_test(test_paper_rate_state),
         cmocka_unit_test(test_bad_inputs),
         cmocka_unit_test(test_every_key_rejects_bad_values),
+        cmocka_unit_test(test_distribution_errors),
         cmocka_unit_test(test_commands),
         cmocka_unit_test(test_progress_on_terminal),
         cmocka_unit_test(test_interrupted_run_is_marked),

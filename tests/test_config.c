@@ -132,6 +132,92 @@ static void test_defaults(void **state)
     bk_config_free(c);
 }
 
+/* Keys given as distributions: one value per block from [model] seed, each entry its own stream
+ * (a block's value depends on the seed, the entry and its index only), a block's own section
+ * winning without shifting the others, and every block's value kept for /parameters. */
+#define DRAWN_CONFIG(block7)                                                     \
+    "[model]\nn_blocks = 2000\ncoupling_stiffness = 1e4\n"                       \
+    "[block]\nmass = normal(2, 0.1)\ndriver_stiffness = lognormal(9.2, 0.05)\n" \
+    "[block.7]\n" block7 "[friction]\nlaw = coulomb\nmu_s = uniform(0.55, 0.65)\nmu_d = 0.5\n" \
+    "[driver]\nvelocity = 1e-3\n[run]\nt_end = 1\n"
+static const char *const drawn_config = DRAWN_CONFIG("mass = 3\n");
+
+static bk_config *load_drawn(const char *text, const char *override)
+{
+    bk_config *c = NULL;
+    bk_error err = {0};
+    const char *overrides[1] = {override};
+    int rc = bk_config_load_string(text, "drawn.ini", overrides, override ? 1 : 0, &c, &err);
+    if (rc != BK_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(rc, BK_OK);
+    return c;
+}
+
+static void test_distributions(void **state)
+{
+    (void)state;
+    bk_config *c = load_drawn(drawn_config, NULL);
+    const bk_model *m = c->model;
+    size_t n = m->n_blocks;
+    double sum = 0.0, sum2 = 0.0, log_sum = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        double mu_s = m->blocks[i].friction_params[0];
+        assert_true(mu_s >= 0.55 && mu_s <= 0.65);
+        log_sum += log(m->blocks[i].driver_stiffness);
+        if (i == 7)
+            continue;
+        sum += m->blocks[i].mass;
+        sum2 += m->blocks[i].mass * m->blocks[i].mass;
+    }
+    assert_close(m->blocks[7].mass, 3.0, 0, 0);
+    double mean = sum / (double)(n - 1), sd = sqrt(sum2 / (double)(n - 1) - mean * mean);
+    print_message("2000 blocks: mass mean %.4f sd %.4f (normal(2, 0.1)); mean log k %.4f (lognormal(9.2, 0.05))\n",
+                  mean, sd, log_sum / (double)n);
+    assert_true(fabs(mean - 2.0) < 5 * 0.1 / sqrt((double)n));
+    assert_true(fabs(sd - 0.1) < 0.01);
+    assert_true(fabs(log_sum / (double)n - 9.2) < 5 * 0.05 / sqrt((double)n));
+    /* Every block's value, for /parameters, in the order the keys first appear. */
+    assert_int_equal(c->n_parameters, 3);
+    assert_string_equal(c->parameters[0].name, "block.mass");
+    assert_string_equal(c->parameters[0].unit, "kg");
+    assert_string_equal(c->parameters[1].name, "block.driver_stiffness");
+    assert_string_equal(c->parameters[2].name, "friction.mu_s");
+    for (size_t i = 0; i < n; ++i) {
+        assert_true(c->parameters[0].values[i] == m->blocks[i].mass);
+        assert_true(c->parameters[1].values[i] == m->blocks[i].driver_stiffness);
+        assert_true(c->parameters[2].values[i] == m->blocks[i].friction_params[0]);
+    }
+
+    /* The same seed, the same values; another seed, others. */
+    bk_config *same = load_drawn(drawn_config, NULL), *other = load_drawn(drawn_config, "model.seed=2");
+    size_t differ = 0;
+    for (size_t i = 0; i < n; ++i) {
+        assert_true(same->model->blocks[i].mass == m->blocks[i].mass);
+        differ += other->model->blocks[i].mass != m->blocks[i].mass;
+    }
+    assert_int_equal(differ, n - 1); /* all but block 7 */
+    bk_config_free(same);
+    bk_config_free(other);
+
+    /* Without block 7's own value, and with another key drawn too: every other block keeps its
+     * mass, bit for bit. */
+    bk_config *changed = load_drawn(DRAWN_CONFIG("x_init = normal(0, 1e-6)\n"), "block.v_init=normal(0, 1e-4)");
+    for (size_t i = 0; i < n; ++i)
+        if (i != 7)
+            assert_true(changed->model->blocks[i].mass == m->blocks[i].mass);
+    assert_true(changed->model->blocks[7].mass != 3.0);
+    assert_true(changed->model->blocks[0].v_init != 0.0);
+    bk_config_free(changed);
+    bk_config_free(c);
+    /* A block that sets the key itself never sees the shared draw, in range or not. */
+    bk_config *own = load_drawn("[model]\nn_blocks = 1\n[block]\nmass = normal(-5, 0.1)\ndriver_stiffness = 1e4\n"
+                                "[block.0]\nmass = 1\n[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
+                                "[driver]\nvelocity = 1e-3\n[run]\nt_end = 1\n", NULL);
+    assert_close(own->model->blocks[0].mass, 1.0, 0, 0);
+    bk_config_free(own);
+}
+
 /* An interval given in simulated time writes every restart point unless a wall-clock interval
  * is given too; 0 turns restart points off altogether. */
 static void test_checkpoint_keys(void **state)
@@ -314,6 +400,27 @@ static void test_rejections(void **state)
          "t.ini:5: [block] x_init: block 0's initial elastic energy overflows a double"},
         {"mu_d = 0.5\n", "mu_d = 0.5\n[friction.0]\nmu_s = 0.4\n",
          "t.ini:9: [friction] mu_d: must be <= mu_s (0.4), got 0.5 (block 0: t.ini:11 sets [friction.0] mu_s = 0.4)"},
+        /* Values drawn per block. */
+        {"mass = 1\n", "mass = normal(1, -0.1)\n",
+         "t.ini:4: [block] mass: normal(1, -0.1) has a negative width (allowed: sd >= 0)"},
+        {"mass = 1\n", "mass = uniform(2, 1)\n", "t.ini:4: [block] mass: uniform(2, 1) has a negative width (allowed: a <= b)"},
+        {"mass = 1\n", "mass = lognormal(0, -1)\n",
+         "t.ini:4: [block] mass: lognormal(0, -1) has a negative width (allowed: sigma >= 0)"},
+        {"mu_d = 0.5\n", "mu_d = uniform(-0.1, 0.5)\n",
+         "t.ini:9: [friction] mu_d: uniform(-0.1, 0.5) reaches outside the allowed range (allowed: 0 <= mu_d < inf)"},
+        {"mass = 1\n", "mass = normal(-1, 0.1)\n", "t.ini:4: [block] mass: normal(-1, 0.1) drew -"},
+        {"mass = 1\n", "mass = normal(-1, 0.1)\n",
+         "for block 0, outside the allowed range (allowed: 0 < mass < inf kg; narrow the distribution, or set "
+         "that block in [block.0])"},
+        {"velocity = 1e-3\n", "velocity = uniform(1e-3, 2e-3)\n",
+         "t.ini:11: [driver] velocity: a distribution is drawn per block: only keys of [block] and [friction] take one"},
+        {"mass = 1\n", "mass = normal(1)\n",
+         "t.ini:4: [block] mass: not a distribution: \"normal(1)\" (allowed: uniform(a, b), normal(mean, sd) or "
+         "lognormal(mu, sigma) with finite numbers)"},
+        {"mass = 1\n", "mass = normal(1, 0.1) x\n", "t.ini:4: [block] mass: not a distribution"},
+        {"mu_d = 0.5\n", "mu_d = uniform(0.7, 0.8)\n",
+         "t.ini:9: [friction] mu_d: must be <= mu_s (0.6), got 0.7"},
+        {"mu_d = 0.5\n", "mu_d = uniform(0.7, 0.8)\n", "(drawn for block 0)"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         char text[4096];
@@ -595,6 +702,7 @@ int main(void)
         cmocka_unit_test(test_full_config),
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(test_checkpoint_keys),
+        cmocka_unit_test(test_distributions),
         cmocka_unit_test(test_event_rows_auto),
         cmocka_unit_test(test_tolerated_forms),
         cmocka_unit_test(test_rejections),

@@ -324,6 +324,48 @@ static void test_write_behind_leaves_no_descriptor(void **state)
     bk_config_free(c);
 }
 
+/* Keys given as distributions: /parameters/<section>.<key> holds every block's value, with units,
+ * and `bksim info` still takes the file as intact. */
+static void test_drawn_parameters(void **state)
+{
+    output_fixture *f = *state;
+    const char *text = "[model]\nn_blocks = 3\n[block]\nmass = uniform(1, 2)\ndriver_stiffness = 1e4\n"
+                       "[block.1]\nmass = 5\n[friction]\nlaw = coulomb\nmu_s = normal(0.6, 0.01)\nmu_d = 0.5\n"
+                       "[driver]\nvelocity = 1e-3\n[run]\nt_end = 1\n";
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(text, "drawn.ini", NULL, 0, &c, &err), BK_OK);
+    bk_h5_writer *w;
+    assert_int_equal(bk_h5_writer_open(&w, c, f->path, &err), BK_OK);
+    bk_sink sink = bk_h5_writer_sink(w);
+    bk_run_stats stats;
+    assert_int_equal(bk_run(c, &sink, &stats, NULL, NULL, &err), BK_OK);
+    assert_int_equal(bk_h5_writer_finish(w, &stats, &err), BK_OK);
+    hid_t file = H5Fopen(f->path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(file >= 0);
+    double data[3];
+    hid_t dset = H5Dopen2(file, "parameters/block.mass", H5P_DEFAULT);
+    assert_true(dset >= 0);
+    assert_true(H5Dread(dset, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0);
+    for (size_t i = 0; i < 3; ++i)
+        assert_true(data[i] == c->model->blocks[i].mass);
+    assert_true(data[0] >= 1.0 && data[0] <= 2.0 && data[1] == 5.0);
+    char *units = attr_string(dset, "units");
+    assert_string_equal(units, "kg");
+    free(units);
+    H5Dclose(dset);
+    dset = H5Dopen2(file, "parameters/friction.mu_s", H5P_DEFAULT);
+    assert_true(dset >= 0);
+    assert_true(H5Dread(dset, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0);
+    for (size_t i = 0; i < 3; ++i)
+        assert_true(data[i] == c->model->blocks[i].friction_params[0]);
+    H5Dclose(dset);
+    assert_true(H5Lexists(file, "parameters/block.driver_stiffness", H5P_DEFAULT) == 0); /* not drawn */
+    H5Fclose(file);
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+    bk_config_free(c);
+}
+
 static void test_empty_run(void **state)
 {
     output_fixture *f = *state;
@@ -640,6 +682,7 @@ int main(int argc, char **argv)
         OUTPUT_TEST(test_wide_chain_chunks_capped),
         OUTPUT_TEST(test_write_behind_leaves_no_descriptor),
         OUTPUT_TEST(test_empty_run),
+        OUTPUT_TEST(test_drawn_parameters),
         OUTPUT_TEST(test_finish_replaces_old_output),
         OUTPUT_TEST(test_sink_rejects_bad_input),
         OUTPUT_TEST(test_write_failure_finish),

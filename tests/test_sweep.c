@@ -153,8 +153,15 @@ static void test_killed_sweep_completes(void **state)
     snprintf(cmd, sizeof cmd, "scripts/sweep.sh -j 2 -o %s %s", dir, sweep_args);
     char *text = NULL;
     status = run_command(cmd, &text);
-    if (status != 0)
+    if (status != 0) {
         print_message("%s", text);
+        free(text);
+        /* Why: the failed points' status lines and the end of their logs. */
+        snprintf(cmd, sizeof cmd, "cd '%s' && grep FAILED sweep.log; for f in logs/*.log; do "
+                 "grep -q -E 'Aborted|ERROR|error' \"$f\" && { echo \"== $f\"; tail -n 40 \"$f\"; }; done", dir);
+        run_command(cmd, &text);
+        print_message("%s", text);
+    }
     free(text);
     assert_int_equal(status, 0);
     assert_int_equal(count_suffix(dir, ".h5"), N_MU * N_V);

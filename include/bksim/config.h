@@ -97,6 +97,16 @@ typedef struct bk_catalog_options {
                                    catalog) while |v| exceeds it; NaN = none given */
 } bk_catalog_options;
 
+/* A key given as a distribution ([block] mass = normal(1, 0.1)): the value every block ended
+ * with, drawn or set by its own section, written to the output as /parameters/<name>. */
+#define BK_PARAMETER_NAME_LEN 128
+typedef struct bk_block_parameter {
+    char name[BK_PARAMETER_NAME_LEN]; /* "<section>.<key>": "block.mass", "friction.mu_s" */
+    char unit[16];
+    size_t n_blocks;
+    double *values;                   /* one per block; NaN where the block's law has no such key */
+} bk_block_parameter;
+
 typedef struct bk_config {
     bk_model *model;          /* owned */
     bk_prescribed *prescribed; /* owned; NULL for the chain's dynamics */
@@ -112,6 +122,8 @@ typedef struct bk_config {
     char **overrides;         /* the --set overrides, owned (kept to reload the same config) */
     size_t n_overrides;
     char *file_text;          /* the config as read, without the overrides, owned */
+    bk_block_parameter *parameters; /* the keys given as a distribution, owned */
+    size_t n_parameters;
 } bk_config;
 
 /* Load and validate a config file.  overrides are "section.key=value" strings applied after

@@ -56,6 +56,34 @@ done:
     return dset;
 }
 
+/* /parameters/<section>.<key>: every block's value of a key given as a distribution, so that
+ * the run can be analysed, and its heterogeneity seen, without the config and its seed. */
+static int write_parameters(bk_h5_writer *w, const bk_config *config, bk_error *err)
+{
+    if (config->n_parameters == 0)
+        return BK_OK;
+    hid_t group = H5Gcreate2(w->file, "parameters", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    int rc = group >= 0 ? BK_OK : H5_FAIL(err, "%s: cannot create group /parameters", w->part);
+    for (size_t k = 0; rc == BK_OK && k < config->n_parameters; ++k) {
+        const bk_block_parameter *p = &config->parameters[k];
+        hsize_t n = (hsize_t)p->n_blocks;
+        hid_t space = H5Screate_simple(1, &n, NULL);
+        hid_t dset = space >= 0 ? H5Dcreate2(group, p->name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT,
+                                             H5P_DEFAULT)
+                                : -1;
+        char description[BK_PARAMETER_NAME_LEN + 192];
+        snprintf(description, sizeof description, "the value of %s of every block, drawn at load time from "
+                 "[model] seed where the config gives a distribution (NaN: the block's law has no such key)",
+                 p->name);
+        if (dset < 0 || H5Dwrite(dset, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, p->values) < 0 ||
+            bk_h5_describe(dset, p->unit, description) < 0)
+            rc = H5_FAIL(err, "%s: cannot write /parameters/%s", w->part, p->name);
+        CLOSE_IDS(rc == BK_OK ? 0 : -1, dset, space);
+    }
+    CLOSE_IDS(rc == BK_OK ? 0 : -1, group);
+    return rc;
+}
+
 /* Which block each friction-state column belongs to (-1 when no block claims it). */
 static herr_t write_state_blocks(hid_t dset, const bk_model *model)
 {
@@ -184,6 +212,9 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
         if (bk_h5_describe(t->dset, table_units[k], table_descriptions[k]) < 0)
             return H5_FAIL(err, "%s: cannot write attributes of /%s", w->part, table_names[k]);
     }
+    int rc = write_parameters(w, config, err);
+    if (rc != BK_OK)
+        return rc;
     /* The variable-length strings above go to disk now, once: nothing rewrites them later
      * (see bk_h5_write_fixed_string_attr). */
     if (H5Fflush(w->file, H5F_SCOPE_LOCAL) < 0)
