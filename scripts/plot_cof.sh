@@ -10,13 +10,8 @@ set -euo pipefail
 here=$(dirname "$0")
 source "$here/plot_lib.sh"
 bksim=${BKSIM:-./bksim}
-usage() { sed -n 's/^# usage: /usage: /p' "$0" >&2; exit 2; }
-status=0
-plot_options "$@" || status=$?
-[ $status -eq 3 ] && { sed -n '2,9s/^# \{0,1\}//p' "$0"; exit 0; }
-[ $status -eq 0 ] || usage
-shift "$PLOT_SHIFT"
-[ $# -ge 3 ] || usage
+plot_setup "$0" 2,9 3 "$@"
+set -- "${PLOT_ARGS[@]}"
 terminal=$PLOT_TERMINAL
 block=$PLOT_BLOCK
 out=$1; title=$2; shift 2

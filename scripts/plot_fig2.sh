@@ -6,13 +6,8 @@ set -euo pipefail
 here=$(dirname "$0")
 source "$here/plot_lib.sh"
 bksim=${BKSIM:-./bksim}
-usage() { sed -n 's/^# usage: /usage: /p' "$0" >&2; exit 2; }
-status=0
-plot_options "$@" || status=$?
-[ $status -eq 3 ] && { sed -n 's/^# usage: /usage: /p' "$0"; exit 0; }
-[ $status -eq 0 ] || usage
-shift "$PLOT_SHIFT"
-[ $# -ge 2 ] || usage
+plot_setup "$0" 2,4 2 "$@"
+set -- "${PLOT_ARGS[@]}"
 terminal=$PLOT_TERMINAL
 block=$PLOT_BLOCK
 out=$1; run=$2; L0=${3:-2e-5}

@@ -37,3 +37,20 @@ plot_options() {
     PLOT_TERMINAL=$(plot_terminal "$format") || return 2
     plot_check_block "$PLOT_BLOCK" || return 2
 }
+
+# plot_setup SCRIPT HELP_LINES MIN_ARGS "$@": the start every plot script shares.  Parses the
+# options (plot_options); --help prints SCRIPT's comment lines HELP_LINES (a sed range) and
+# exits 0; a bad option or fewer than MIN_ARGS arguments print the usage line and exit 2.
+# Sets PLOT_TERMINAL, PLOT_BLOCK and PLOT_ARGS (the arguments after the options).
+plot_setup() {
+    local script=$1 help=$2 min=$3 status=0
+    shift 3
+    plot_options "$@" || status=$?
+    [ $status -eq 3 ] && { sed -n "${help}s/^# \{0,1\}//p" "$script"; exit 0; }
+    shift "$PLOT_SHIFT"
+    if [ $status -ne 0 ] || [ $# -lt "$min" ]; then
+        sed -n 's/^# usage: /usage: /p' "$script" >&2
+        exit 2
+    fi
+    PLOT_ARGS=("$@")
+}

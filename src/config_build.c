@@ -214,17 +214,14 @@ static void build_chain(loader *ld, bk_config *c)
     m->driver.start_position = value_of(ld, "driver", "start_position");
 
     static const char *const required[] = {"mass", "driver_stiffness"};
-    ld->seed = (unsigned long)value_of(ld, "model", "seed");
-    if (bk_config_plan_parameters(ld, n) != 0) {
-        bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+    if (bk_config_plan_parameters(ld, n) != 0)
         return;
-    }
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
     if (!rng) {
         bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
         return;
     }
-    gsl_rng_set(rng, (unsigned long)value_of(ld, "model", "seed"));
+    gsl_rng_set(rng, ld->seed);
     for (size_t i = 0; i < n; ++i) {
         bk_block *b = &m->blocks[i];
         int given;
@@ -320,11 +317,8 @@ static void build_prescribed(loader *ld, bk_config *c)
     }
     m->gravity = value_of(ld, "model", "gravity");
     m->driver.velocity = first_rate;
-    ld->seed = (unsigned long)value_of(ld, "model", "seed");
-    if (bk_config_plan_parameters(ld, 1) != 0) {
-        bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+    if (bk_config_plan_parameters(ld, 1) != 0)
         return;
-    }
     bk_block *b = &m->blocks[0];
     int given_mass, given_normal;
     double mass = block_value(ld, 0, "mass", &given_mass);
@@ -416,6 +410,7 @@ bk_config *bk_config_build(loader *ld)
     if (!c)
         return NULL;
     c->t_end = NAN; /* unknown until read: no cross-check against it before then */
+    ld->seed = (unsigned long)value_of(ld, "model", "seed");
     if (has_section(ld, "prescribed"))
         build_prescribed(ld, c);
     else
@@ -442,7 +437,7 @@ bk_config *bk_config_build(loader *ld)
              bk_solver_arkode_table((size_t)value_of(ld, "solver", "arkode_table")));
     check_method_fits(ld, c);
     c->wall_time_limit = value_of(ld, "run", "wall_time_limit");
-    c->seed = (unsigned long)value_of(ld, "model", "seed");
+    c->seed = ld->seed;
 
     bk_output_options *o = &c->output;
     entry *path = bk_config_lookup(ld, "output", "path");

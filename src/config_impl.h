@@ -104,8 +104,8 @@ int bk_config_parse_distribution(loader *ld, entry *e, const bk_param *param, co
  * draw falls outside param's range. */
 double bk_config_draw(loader *ld, entry *e, size_t block, const bk_param *param);
 void bk_config_free_draws(entry *e);
-/* A /parameters array for every key some entry draws; the values blocks end with go in by
- * bk_config_record_parameter (a key without an array is ignored). */
+/* A /parameters array for every key some entry draws (-1, reported, when out of memory); the
+ * values blocks end with go in by bk_config_record_parameter (a key without one is ignored). */
 int bk_config_plan_parameters(loader *ld, size_t n_blocks);
 void bk_config_record_parameter(loader *ld, const char *base, const char *key, const char *unit, size_t block,
                                 double value);

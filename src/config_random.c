@@ -145,7 +145,8 @@ void bk_config_free_draws(entry *e)
 
 int bk_config_plan_parameters(loader *ld, size_t n_blocks)
 {
-    for (size_t i = 0; i < ld->n; ++i) {
+    size_t i = 0;
+    for (; i < ld->n; ++i) {
         const entry *e = &ld->entries[i];
         if (e->superseded || !e->distribution)
             continue;
@@ -158,7 +159,7 @@ int bk_config_plan_parameters(loader *ld, size_t n_blocks)
             continue;
         bk_block_parameter *grown = realloc(ld->parameters, (ld->n_parameters + 1) * sizeof *grown);
         if (!grown)
-            return -1;
+            break;
         ld->parameters = grown;
         bk_block_parameter *p = &ld->parameters[ld->n_parameters++];
         memset(p, 0, sizeof *p);
@@ -166,11 +167,14 @@ int bk_config_plan_parameters(loader *ld, size_t n_blocks)
         p->n_blocks = n_blocks;
         p->values = malloc(n_blocks * sizeof *p->values);
         if (!p->values)
-            return -1;
+            break;
         for (size_t b = 0; b < n_blocks; ++b)
             p->values[b] = NAN; /* a block whose law has no such parameter */
     }
-    return 0;
+    if (i == ld->n)
+        return 0;
+    bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+    return -1;
 }
 
 void bk_config_record_parameter(loader *ld, const char *base, const char *key, const char *unit, size_t block,

@@ -41,7 +41,7 @@ static double fastest_slip_speed(const bk_model *m)
     for (size_t i = 0; i < m->n_blocks; ++i) {
         const bk_block *b = &m->blocks[i];
         const bk_friction_law *law = b->law;
-        double k = b->driver_stiffness + bk_model_coupling_count(m, i) * m->coupling_stiffness;
+        double k = bk_model_block_stiffness(m, i);
         if (!law || !law->static_threshold || !(k > 0.0))
             continue;
         double state[BK_FRICTION_MAX_STATE] = {0};
@@ -64,7 +64,7 @@ static double slowest_half_period(const bk_model *m)
         const bk_block *b = &m->blocks[i];
         if (!b->law || !b->law->static_threshold)
             continue;
-        double k = b->driver_stiffness + bk_model_coupling_count(m, i) * m->coupling_stiffness;
+        double k = bk_model_block_stiffness(m, i);
         double t = k > 0.0 ? BK_PI / sqrt(k / b->mass) : INFINITY;
         if (t > half)
             half = t;

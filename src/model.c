@@ -67,6 +67,11 @@ int bk_model_coupling_count(const bk_model *model, size_t i)
     return (left != -1) + (right != -1);
 }
 
+double bk_model_block_stiffness(const bk_model *model, size_t i)
+{
+    return model->blocks[i].driver_stiffness + bk_model_coupling_count(model, i) * model->coupling_stiffness;
+}
+
 double bk_model_coupling_force(const bk_model *model, size_t i, const double *x)
 {
     double kc = model->coupling_stiffness;

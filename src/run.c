@@ -196,7 +196,7 @@ static int schedule(run_ctx *ctx)
             break;
         case SAMPLE:
             if ((rc = bk_run_unpack_all(ctx, t_action)) == BK_OK &&
-                (rc = bk_run_emit_row(ctx, t_action, BK_ROW_SAMPLE)) == BK_OK)
+                (rc = bk_run_emit_sample(ctx, t_action)) == BK_OK)
                 ctx->next_sample++;
             break;
         case STOP:
@@ -208,7 +208,7 @@ static int schedule(run_ctx *ctx)
                 return rc;
             /* The final row, unless an event row at t_end took its place. */
             if (ctx->next_sample >= 0)
-                rc = bk_run_emit_row(ctx, ctx->t_end, BK_ROW_SAMPLE);
+                rc = bk_run_emit_sample(ctx, ctx->t_end);
             ctx->next_sample = -1;
             return rc;
         }
@@ -228,8 +228,7 @@ static void resolve_scales(run_ctx *ctx)
     double period = omega > 0.0 ? 2.0 * PI / omega : INFINITY;
     double length = 0.0, force = 0.0;
     for (size_t i = 0; i < model->n_blocks; ++i) {
-        double stiffness = model->blocks[i].driver_stiffness +
-                           bk_model_coupling_count(model, i) * model->coupling_stiffness;
+        double stiffness = bk_model_block_stiffness(model, i);
         double driver_speed = fabs(model->driver.velocity) > 0.0 ? fabs(model->driver.velocity) : 1e-3;
         double threshold = ctx->scene.can_stick[i] ? bk_scene_static_threshold(&ctx->scene, i)
                                                    : fabs(bk_scene_sliding_force(&ctx->scene, i, driver_speed));
@@ -406,7 +405,7 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
         ctx.kinetic0 = bk_model_kinetic_energy(ctx.model, ctx.scene.v);
         if ((rc = bk_run_partition_all(&ctx, 0.0)) != BK_OK ||
             (rc = bk_run_flush_instant(&ctx)) != BK_OK || (rc = bk_run_unpack_all(&ctx, 0.0)) != BK_OK ||
-            (rc = (moved ? bk_run_emit_event_rows(&ctx, 0.0) : bk_run_emit_row(&ctx, 0.0, BK_ROW_SAMPLE))) != BK_OK)
+            (rc = (moved ? bk_run_emit_event_rows(&ctx, 0.0) : bk_run_emit_sample(&ctx, 0.0))) != BK_OK)
             goto done;
         ctx.next_sample = 1;
     }

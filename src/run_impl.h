@@ -201,8 +201,8 @@ int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl);
 /* ---- run_output.c ---- */
 /* Count bytes written (rows, transitions, events) against [output] max_bytes at t. */
 int bk_run_count_bytes(run_ctx *ctx, double bytes, double t);
-/* A row from the chain's arrays at t (bk_run_unpack_all first); is_event is a bk_row_kind. */
-int bk_run_emit_row(run_ctx *ctx, double t, int is_event);
+/* A regular sample row from the chain's arrays at t (bk_run_unpack_all first). */
+int bk_run_emit_sample(run_ctx *ctx, double t);
 /* The two rows of a transition instant at t (unpacked there): the state just before its
  * transitions, then just after. */
 int bk_run_emit_event_rows(run_ctx *ctx, double t);

@@ -80,10 +80,10 @@ static int before_rows(run_ctx *ctx, double t, int rows)
     return rc != BK_OK ? rc : bk_run_count_bytes(ctx, rows * ctx->row_bytes, t);
 }
 
-int bk_run_emit_row(run_ctx *ctx, double t, int is_event)
+int bk_run_emit_sample(run_ctx *ctx, double t)
 {
     int rc = before_rows(ctx, t, 1);
-    return rc != BK_OK ? rc : send_row(ctx, t, (bk_row_kind)is_event);
+    return rc != BK_OK ? rc : send_row(ctx, t, BK_ROW_SAMPLE);
 }
 
 int bk_run_emit_event_rows(run_ctx *ctx, double t)

@@ -74,6 +74,9 @@ double bk_model_max_angular_frequency(const bk_model *model);
 void bk_model_neighbours(const bk_model *model, size_t i, long *left, long *right);
 /* Number of neighbours block i is coupled to (walls included), 0..2. */
 int bk_model_coupling_count(const bk_model *model, size_t i);
+/* Block i's own stiffness (N/m): its driver spring and its coupling springs, the others held
+ * fixed; sqrt of it over the mass is the block's natural angular frequency. */
+double bk_model_block_stiffness(const bk_model *model, size_t i);
 /* The first block whose law has a state or a velocity-dependent sliding force, or n_blocks
  * when there is none: every law Coulomb-like, so between mode changes the chain is linear
  * with constant coefficients (what method = exact needs). */

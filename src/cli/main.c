@@ -82,7 +82,8 @@ static const char *const info_help =
     "usage: bksim info OUT.h5 [--blocks]\n"
     "\n"
     "Prints the parameters, stick/slip phase counts and solver statistics, and checks the\n"
-    "file: datasets present and equally long, time strictly increasing, the complete flag.\n"
+    "file: datasets present and equally long, time increasing (equal only for a transition\n"
+    "instant's before and after rows), the complete flag.\n"
     "Chains of up to 20 blocks get one line per block; longer ones totals, the spread of\n"
     "slips per block and the most active blocks.\n"
     "  --blocks   one line per block whatever the chain's length\n"
@@ -496,21 +497,18 @@ static int cmd_run(int argc, char **argv)
         /* Say how to go on: from the last checkpoint, or (none) only by starting over. */
         double t_checkpoint = 0.0;
         bk_error ignored = {0};
+        fprintf(stderr, "bksim: partial output left in %s.part (complete = 0); ", path);
         if (bk_h5_restartable(path, &t_checkpoint, &ignored) == 1)
-            fprintf(stderr, "bksim: partial output left in %s.part (complete = 0); continue it from "
-                            "its checkpoint t = %.17g s with `bksim run --restart %s.part`\n",
-                    path, t_checkpoint, path);
+            fprintf(stderr, "continue it from its checkpoint t = %.17g s with `bksim run --restart %s.part`\n",
+                    t_checkpoint, path);
         else if (config->output.checkpoint_interval > 0.0 || config->output.checkpoint_work > 0.0)
-            fprintf(stderr, "bksim: partial output left in %s.part (complete = 0); it holds no "
-                            "checkpoint, so it cannot be continued: running again starts over (the "
-                            "run writes its first at the restart point after [output] "
+            fprintf(stderr, "it holds no checkpoint, so it cannot be continued: running again starts over "
+                            "(the run writes its first at the restart point after [output] "
                             "checkpoint_wall_interval = %g s)\n",
-                    path, config->output.checkpoint_wall_interval);
+                    config->output.checkpoint_wall_interval);
         else
-            fprintf(stderr, "bksim: partial output left in %s.part (complete = 0); it holds no "
-                            "checkpoint ([output] checkpoint_interval = 0), so it cannot be "
-                            "continued: running again starts over\n",
-                    path);
+            fprintf(stderr, "it holds no checkpoint, so it cannot be continued: running again starts over "
+                            "([output] checkpoint_interval = 0 writes none)\n");
         status = EXIT_RUN_FAILED;
     } else if (bk_h5_writer_finish(writer, &stats, &err) != BK_OK) {
         fprintf(stderr, "%s\n", err.message);

@@ -194,6 +194,9 @@ herr_t bk_h5_read_block_xfer(hid_t dset, int rank, hsize_t start, hsize_t count,
                              hsize_t ncols, hid_t mem_type, void *buf, hid_t dxpl);
 /* First-dimension chunk size of a chunked dataset; 0 when not chunked. */
 hsize_t bk_h5_chunk_rows(hid_t dset);
+/* Rows to read at a time when streaming a series of cols columns: whole chunks (a partial
+ * chunk would be read and its checksum computed once per piece), about EXPORT_BUDGET values. */
+hsize_t bk_h5_slab_rows(hid_t dset, hsize_t cols);
 
 typedef struct bk_h5_name_list {
     char **names;

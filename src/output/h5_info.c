@@ -183,22 +183,24 @@ static int print_phase_summary(FILE *out, const char *path, size_t n, const long
             sorted[0], sorted[n / 4], sorted[n / 2], sorted[3 * n / 4], sorted[n - 1], never,
             never == 1 ? "" : "s");
     free(sorted);
-    /* The five most active, by slips (the lower index first on a tie). */
-    fprintf(out, "    most active:");
-    size_t shown[5];
-    size_t n_shown = 0;
-    for (size_t k = 0; k < 5 && k < n; ++k) {
-        size_t best = n;
-        for (size_t i = 0; i < n; ++i) {
-            int taken = 0;
-            for (size_t j = 0; j < n_shown; ++j)
-                taken |= shown[j] == i;
-            if (!taken && (best == n || slip[i] > slip[best]))
-                best = i;
-        }
-        shown[n_shown++] = best;
-        fprintf(out, "%s block %zu (%ld slips)", k ? "," : "", best, slip[best]);
+    /* The five most active, by slips (the lower index first on a tie): one pass, each block
+     * inserted into the sorted top five. */
+    size_t top[5];
+    size_t n_top = 0;
+    for (size_t i = 0; i < n; ++i) {
+        size_t at = n_top;
+        while (at > 0 && slip[i] > slip[top[at - 1]])
+            --at;
+        if (at == 5)
+            continue;
+        if (n_top < 5)
+            ++n_top;
+        memmove(&top[at + 1], &top[at], (n_top - 1 - at) * sizeof *top);
+        top[at] = i;
     }
+    fprintf(out, "    most active:");
+    for (size_t k = 0; k < n_top; ++k)
+        fprintf(out, "%s block %zu (%ld slips)", k ? "," : "", top[k], slip[top[k]]);
     fprintf(out, "\n    (one line per block: bksim info %s --blocks)\n", path);
     return 0;
 }
@@ -368,13 +370,17 @@ int bk_h5_info_blocks(const char *path, FILE *out, int per_block, bk_error *err)
         fprintf(out, "complete     ?\n");
     if (error)
         fprintf(out, "error        %s\n", error);
-    double t_checkpoint = have_complete && !complete ? newest_checkpoint(file) : NAN;
     if (have_complete && !complete) {
-        if (isfinite(t_checkpoint))
+        /* The checkpoint a restart would use: the newest slot that verifies. */
+        bk_h5_slot slot;
+        bk_error why = {0};
+        if (n_blocks > 0 && bk_h5_find_checkpoint(file, path, (size_t)n_blocks, &slot, &why) == BK_OK) {
             fprintf(out, "checkpoint   t = %.17g s: `bksim run --restart %s` continues from it\n",
-                    t_checkpoint, path);
-        else
+                    slot.checkpoint.t, path);
+            bk_checkpoint_free(&slot.checkpoint);
+        } else {
             fprintf(out, "checkpoint   none: this run cannot be continued, only run again\n");
+        }
     }
     fprintf(out, "t_end        %.9g s\n", t_end);
     fprintf(out, "t_reached    %.9g s\n", t_reached);

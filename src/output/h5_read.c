@@ -186,6 +186,15 @@ hsize_t bk_h5_chunk_rows(hid_t dset)
     return chunk[0];
 }
 
+hsize_t bk_h5_slab_rows(hid_t dset, hsize_t cols)
+{
+    hsize_t chunk = bk_h5_chunk_rows(dset);
+    if (chunk == 0)
+        chunk = 1;
+    hsize_t chunks = EXPORT_BUDGET / (chunk * (cols ? cols : 1));
+    return chunk * (chunks ? chunks : 1);
+}
+
 int bk_h5_read_doubles(const char *path, const char *dataset, double **data, size_t *rows,
                        size_t *cols, bk_error *err)
 {

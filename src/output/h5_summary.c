@@ -214,7 +214,7 @@ static int series_peak_slip_rate(hid_t file, const char *path, run_row *run, bk_
     int rc = bk_h5_open_series(file, path, "v", &dset, &rows, &cols, &rank, err);
     if (rc != BK_OK)
         return rc;
-    hsize_t slab = cols >= 65536 ? 1 : 65536 / (cols ? cols : 1);
+    hsize_t slab = bk_h5_slab_rows(dset, cols);
     double *v = malloc((size_t)(slab * cols) * sizeof *v);
     if (!v)
         rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for /v", path);

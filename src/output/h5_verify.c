@@ -18,17 +18,6 @@ typedef struct verify_ctx {
     int complete;
 } verify_ctx;
 
-/* Rows read at a time while checking: whole chunks (a partial chunk would be read and its
- * checksum computed once per piece), about EXPORT_BUDGET values. */
-static hsize_t scan_step(hid_t dset, hsize_t cols)
-{
-    hsize_t chunk = bk_h5_chunk_rows(dset);
-    if (chunk == 0)
-        chunk = 1;
-    hsize_t chunks = EXPORT_BUDGET / (chunk * (cols ? cols : 1));
-    return chunk * (chunks ? chunks : 1);
-}
-
 /* Every value of one time series, streamed a block of rows at a time: finite, modes and
  * event flags from their sets, /time increasing up to t_reached (and t_end when complete),
  * strictly but for the two rows of a transition instant (/event 2 then 1, at one time).  A
@@ -44,7 +33,7 @@ static int scan_series(hid_t file, const verify_ctx *v, const char *name, bk_err
     int is_time = strcmp(name, "time") == 0;
     int is_mode = strcmp(name, "mode") == 0;
     int is_event = strcmp(name, "event") == 0;
-    hsize_t step = scan_step(dset, cols);
+    hsize_t step = bk_h5_slab_rows(dset, cols);
     if (step > rows)
         step = rows ? rows : 1;
     double *buf = malloc((size_t)(step * cols) * sizeof *buf);
