@@ -7,14 +7,14 @@
 #include <string.h>
 
 #define ARRAY(name, member, type, extent) \
-    {name, 0, BK_CHECKPOINT_##type, BK_CHECKPOINT_##extent, offsetof(bk_checkpoint, member)}
+    {name, 0, BK_CHECKPOINT_##type, BK_CHECKPOINT_##extent, offsetof(bk_checkpoint, member), 0}
 #define SCALAR(member, type) \
-    {#member, 0, BK_CHECKPOINT_##type, BK_CHECKPOINT_SCALAR, offsetof(bk_checkpoint, member)}
+    {#member, 0, BK_CHECKPOINT_##type, BK_CHECKPOINT_SCALAR, offsetof(bk_checkpoint, member), 0}
 /* The catalog builder's state: after the rest, so files without it hash as before. */
 #define CATALOG_ARRAY(member, type) \
-    {"catalog_" #member, 1, BK_CHECKPOINT_##type, BK_CHECKPOINT_PER_BLOCK, offsetof(bk_catalog_state, member)}
+    {"catalog_" #member, 1, BK_CHECKPOINT_##type, BK_CHECKPOINT_PER_BLOCK, offsetof(bk_catalog_state, member), 0}
 #define CATALOG_SCALAR(member, type) \
-    {"catalog_" #member, 1, BK_CHECKPOINT_##type, BK_CHECKPOINT_SCALAR, offsetof(bk_catalog_state, member)}
+    {"catalog_" #member, 1, BK_CHECKPOINT_##type, BK_CHECKPOINT_SCALAR, offsetof(bk_catalog_state, member), 0}
 
 const bk_checkpoint_field bk_checkpoint_fields[] = {
     ARRAY("mode", mode, I8, PER_BLOCK),
@@ -34,6 +34,7 @@ const bk_checkpoint_field bk_checkpoint_fields[] = {
     SCALAR(t_last_row, F64),
     SCALAR(next_sample, LONG),
     SCALAR(steps_since_row, LONG),
+    {"damping_dissipation", 0, BK_CHECKPOINT_F64, BK_CHECKPOINT_SCALAR, offsetof(bk_checkpoint, damping_dissipation), 1},
     CATALOG_ARRAY(x_onset, F64),
     CATALOG_ARRAY(first_force, F64),
     CATALOG_ARRAY(last_force, F64),
@@ -56,8 +57,8 @@ const size_t bk_checkpoint_n_fields = sizeof bk_checkpoint_fields / sizeof bk_ch
 #undef CATALOG_ARRAY
 #undef CATALOG_SCALAR
 
-#define STAT_L(member, units) {#member, 1, offsetof(bk_run_stats, member), units}
-#define STAT_D(member, units) {#member, 0, offsetof(bk_run_stats, member), units}
+#define STAT_L(member, units) {#member, 1, offsetof(bk_run_stats, member), units, 0}
+#define STAT_D(member, units) {#member, 0, offsetof(bk_run_stats, member), units, 0}
 const bk_stat_field bk_run_stats_fields[] = {
     STAT_L(steps, "1"),          STAT_L(rhs_evals, "1"),
     STAT_L(root_evals, "1"),     STAT_L(err_test_fails, "1"),
@@ -68,6 +69,7 @@ const bk_stat_field bk_run_stats_fields[] = {
     STAT_D(work_driver, "J"),    STAT_D(dissipation, "J"),
     STAT_D(elastic_change, "J"), STAT_D(kinetic_change, "J"),
     STAT_D(energy_residual, "1"),
+    {"damping_dissipation", 0, offsetof(bk_run_stats, damping_dissipation), "J", 1},
 };
 const size_t bk_run_stats_n_fields = sizeof bk_run_stats_fields / sizeof bk_run_stats_fields[0];
 #undef STAT_L
@@ -103,9 +105,33 @@ size_t bk_checkpoint_field_count(const bk_checkpoint_field *field, const bk_chec
     return 1;
 }
 
+int bk_stat_is_zero(const bk_run_stats *stats, const bk_stat_field *field)
+{
+    const char *member = (const char *)stats + field->offset;
+    if (field->is_long) {
+        long value;
+        memcpy(&value, member, sizeof value);
+        return value == 0;
+    }
+    double value;
+    memcpy(&value, member, sizeof value);
+    return value == 0.0;
+}
+
 int bk_checkpoint_field_present(const bk_checkpoint_field *field, const bk_checkpoint *cp)
 {
     return !field->catalog || cp->catalog != NULL;
+}
+
+int bk_checkpoint_field_stored(const bk_checkpoint_field *field, const bk_checkpoint *cp)
+{
+    if (!bk_checkpoint_field_present(field, cp))
+        return 0;
+    if (!field->if_nonzero)
+        return 1;
+    double value;
+    memcpy(&value, bk_checkpoint_field_cdata(field, cp), sizeof value);
+    return value != 0.0;
 }
 
 /* The struct a field is a member of. */
@@ -242,7 +268,7 @@ uint64_t bk_checkpoint_hash(const bk_checkpoint *cp, const bk_checkpoint_record 
     h = hash_u64(h, (uint64_t)cp->n_state);
     for (size_t k = 0; k < bk_checkpoint_n_fields; ++k) {
         const bk_checkpoint_field *f = &bk_checkpoint_fields[k];
-        if (!bk_checkpoint_field_present(f, cp))
+        if (!bk_checkpoint_field_stored(f, cp))
             continue;
         const void *data = bk_checkpoint_field_cdata(f, cp);
         if (f->extent != BK_CHECKPOINT_SCALAR) {
@@ -253,6 +279,8 @@ uint64_t bk_checkpoint_hash(const bk_checkpoint *cp, const bk_checkpoint_record 
     }
     for (size_t i = 0; i < bk_run_stats_n_fields; ++i) {
         const char *member = (const char *)&cp->stats + bk_run_stats_fields[i].offset;
+        if (bk_run_stats_fields[i].if_nonzero && bk_stat_is_zero(&cp->stats, &bk_run_stats_fields[i]))
+            continue;
         if (bk_run_stats_fields[i].is_long) {
             long value;
             memcpy(&value, member, sizeof value);

@@ -208,6 +208,7 @@ static void build_chain(loader *ld, bk_config *c)
     c->model = m;
     m->boundary = (bk_boundary)(int)value_of(ld, "model", "boundary");
     m->coupling_stiffness = value_of(ld, "model", "coupling_stiffness");
+    m->coupling_damping = value_of(ld, "model", "coupling_damping");
     m->gravity = value_of(ld, "model", "gravity");
     m->spring = (bk_spring)(int)value_of(ld, "driver", "spring");
     m->driver.velocity = value_of(ld, "driver", "velocity");
@@ -247,6 +248,7 @@ static void build_chain(loader *ld, bk_config *c)
         /* Drawn for every block, so a block's value does not depend on its neighbours' keys. */
         b->x_init += block_value(ld, i, "x_init_random", &given) * (2.0 * gsl_rng_uniform(rng) - 1.0);
         b->v_init = block_value(ld, i, "v_init", &given);
+        b->damping = block_value(ld, i, "damping", &given);
         build_friction(ld, b, i, m->driver.velocity);
         if (ld->error_rank != LONG_MAX && ld->error_rank >= RANK_MISSING)
             break; /* one missing key is enough; don't repeat it for every block */
@@ -284,6 +286,14 @@ static void build_prescribed(loader *ld, bk_config *c)
     entry *n_blocks = bk_config_lookup(ld, "model", "n_blocks");
     if (n_blocks && n_blocks->number != 1.0)
         bk_config_report_entry(ld, n_blocks, "a prescribed scene has one block, got %s", n_blocks->value);
+    /* The slip rate is imposed, so a dashpot would change nothing a prescribed run reports. */
+    static const char *const dashpots[][2] = {{"block", "damping"}, {"block.0", "damping"}, {"model", "coupling_damping"}};
+    for (size_t d = 0; d < sizeof dashpots / sizeof dashpots[0]; ++d) {
+        entry *e = bk_config_lookup(ld, dashpots[d][0], dashpots[d][1]);
+        if (e)
+            bk_config_report_entry(ld, e, "a prescribed scene imposes the slip rate, which no dashpot changes "
+                                   "(allowed: remove the key)");
+    }
     bk_prescribed *pr = calloc(1, sizeof *pr);
     bk_model *m = bk_model_create(1);
     if (pr) {
@@ -360,6 +370,11 @@ static void check_method_fits(loader *ld, const bk_config *c)
                                "block; block %zu uses law %s (allowed: auto, or an integrator such as gsl_rk8pd "
                                "or cvode_bdf)",
                                i, c->model->blocks[i].law->name);
+    else if (bk_model_is_damped(c->model))
+        bk_config_report_entry(ld, method,
+                               "solves motion whose forces do not depend on velocity; [block] damping or [model] "
+                               "coupling_damping makes them (allowed: auto, which picks an integrator here, or one "
+                               "such as gsl_rk8pd or cvode_bdf)");
 }
 
 static int has_section(loader *ld, const char *section)
@@ -484,7 +499,8 @@ bk_config *bk_config_build(loader *ld)
     }
     o->max_bytes = value_of(ld, "output", "max_bytes");
     if (c->model && ld->error_rank == LONG_MAX) {
-        double per_row = bk_output_row_bytes(o->fields, c->model->n_blocks, c->model->n_friction_state);
+        double per_row = bk_output_row_bytes(o->fields, c->model->n_blocks, c->model->n_friction_state,
+                                             bk_model_is_damped(c->model));
         double bytes = (samples + 1.0) * per_row;
         if (bytes > o->max_bytes) {
             entry *at = interval ? interval : bk_config_lookup(ld, "output", "max_bytes");

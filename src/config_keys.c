@@ -48,6 +48,8 @@ static const key_def keys[] = {
     {"model", {"boundary", "", 0, 0, 0, 0, "chain ends: free, fixed (tied to walls at 0) or periodic (a ring)"},
      BK_KEY_CHOICE, boundary_names, NULL, "free"},
     NUM("model", "coupling_stiffness", "N/m", 0.0, 0.0, INFINITY, 0, "stiffness of the springs between neighbours"),
+    NUM("model", "coupling_damping", "N s/m", 0.0, 0.0, INFINITY, 0,
+        "dashpot in parallel with every coupling spring (Carlson-Langer viscosity): force coupling_damping * (v_j - v_i)"),
     NUM("model", "gravity", "m/s^2", 9.81, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
         "gravitational acceleration, for the default normal force"),
     INT("model", "seed", 1, 0, 4294967295.0, 0,
@@ -64,6 +66,8 @@ static const key_def keys[] = {
         "initial velocity (non-zero: the block starts slipping that way)"),
     NUM("block", "x_init_random", "m", 0.0, 0.0, INFINITY, 0,
         "adds a uniform random displacement in [-a, a] to x_init (heterogeneous chains; [model] seed)"),
+    NUM("block", "damping", "N s/m", 0.0, 0.0, INFINITY, 0,
+        "dashpot from the block to the substrate, force -damping * v (the radiation damping of quasi-dynamic models)"),
 
     {"friction", {"law", "", NAN, 0, 0, BK_PARAM_REQUIRED, "friction law; its parameters follow in the same section"},
      BK_KEY_CHOICE, NULL, law_name, NULL},

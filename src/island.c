@@ -22,12 +22,12 @@
 
 size_t bk_island_max_y(const bk_scene *scene, size_t len)
 {
-    return len * (2 + scene->max_block_state) + 2;
+    return len * (2 + scene->max_block_state) + scene->n_energy;
 }
 
 size_t bk_island_y_length(const bk_scene *scene, size_t start, size_t len)
 {
-    size_t n_y = 2;
+    size_t n_y = scene->n_energy;
     for (size_t k = 0; k < len; ++k) {
         size_t i = start + k < scene->n ? start + k : start + k - scene->n;
         if (!bk_scene_stuck(scene, i) || scene->full_layout)
@@ -82,6 +82,18 @@ static inline double position(const bk_island *island, const double *y, long j)
 }
 
 /* Driver-spring force with the spring's taut/slack state frozen since the restart. */
+/* Velocity of block j: this island's blocks from y, any other block (stuck) and a wall 0. */
+static inline double velocity(const bk_island *island, const double *y, long j)
+{
+    if (j < 0)
+        return 0.0;
+    const bk_scene *scene = island->scene;
+    size_t s = scene->slot[j];
+    if (s == BK_NO_SLOT || scene->island_of[j] != island->id)
+        return 0.0;
+    return y[s + 1];
+}
+
 static inline double driver_force(const bk_scene *scene, size_t i, double x_i, double driver_pos)
 {
     if (scene->model->spring == BK_SPRING_TENSION_ONLY && !scene->taut[i])
@@ -100,6 +112,24 @@ static inline double coupling_force(const bk_island *island, const double *y, si
         force += kc * (position(island, y, scene->left[i]) - x_i);
     if (scene->right[i] != -1)
         force += kc * (position(island, y, scene->right[i]) - x_i);
+    return force;
+}
+
+/* Dashpot force on block i moving at v_i (bk_model_damping_force on the island's vector). */
+static inline double damping_force(const bk_island *island, const double *y, size_t i, double v_i)
+{
+    const bk_scene *scene = island->scene;
+    if (!scene->damped)
+        return 0.0;
+    const bk_model *model = scene->model;
+    double force = -model->blocks[i].damping * v_i;
+    double etac = model->coupling_damping;
+    if (etac > 0.0) {
+        if (scene->left[i] != -1)
+            force += etac * (velocity(island, y, scene->left[i]) - v_i);
+        if (scene->right[i] != -1)
+            force += etac * (velocity(island, y, scene->right[i]) - v_i);
+    }
     return force;
 }
 
@@ -174,10 +204,12 @@ void bk_island_restart(bk_island *island, double t, double *y)
         if (R > 2)
             island->root_direction[R * k + BK_ROOT_SLACK] = 0;
     }
-    y[next] = 0.0;     /* driver work on the slipping blocks since t */
-    y[next + 1] = 0.0; /* dissipation since t */
-    island->differential_id[next] = island->differential_id[next + 1] = 1.0;
-    island->n_y = next + 2;
+    /* Driver work on the slipping blocks, friction and dashpot dissipation since t. */
+    for (size_t e = 0; e < scene->n_energy; ++e) {
+        y[next + e] = 0.0;
+        island->differential_id[next + e] = 1.0;
+    }
+    island->n_y = next + scene->n_energy;
     island->half_bandwidth = 3 + max_state;
     island->t_ref = t;
     for (size_t k = 0; k < island->n_active; ++k) {
@@ -204,12 +236,11 @@ void bk_island_tolerances(const bk_island *island, double atol_x, double atol_v,
         for (size_t j = 0; j < scene->model->blocks[i].law->n_state; ++j)
             atol[scene->state_slot[i] + j] = atol_state;
     }
-    atol[island->n_y - 2] = atol_energy;
-    atol[island->n_y - 1] = atol_energy;
+    for (size_t e = island->n_y - scene->n_energy; e < island->n_y; ++e)
+        atol[e] = atol_energy;
 }
 
-void bk_island_unpack(bk_island *island, double t, const double *y, double *work,
-                      double *dissipation)
+void bk_island_unpack(bk_island *island, double t, const double *y, bk_energy *increments)
 {
     bk_scene *scene = island->scene;
     const bk_model *model = scene->model;
@@ -234,14 +265,18 @@ void bk_island_unpack(bk_island *island, double t, const double *y, double *work
                b->law->n_state * sizeof *y);
         scene->state_time[i] = t;
     }
-    if (work)
-        *work = y[island->n_y - 2];
-    if (dissipation)
-        *dissipation = y[island->n_y - 1];
+    if (increments) {
+        const double *energy = &y[island->n_y - scene->n_energy];
+        increments->work = energy[0];
+        increments->friction = energy[1];
+        increments->damping = scene->damped ? energy[2] : 0.0;
+    }
 }
 
-/* The right-hand side, whole (f_implicit NULL) or split: the friction terms (the
- * velocity rows' -s F / m, the state rates) into f_implicit and the rest into ydot. */
+/* The right-hand side, whole (f_implicit NULL) or split: the friction and dashpot terms (the
+ * velocity rows' (G - s F) / m, the state rates) into f_implicit and the rest into ydot.
+ * The dashpots dissipate -sum v_i G_i over the island's blocks (each dashpot once: the pair
+ * terms add up to etac (v_i - v_j)^2). */
 static void rhs_parts(const bk_island *island, double t, const double *y, double *ydot,
                       double *f_implicit)
 {
@@ -249,7 +284,7 @@ static void rhs_parts(const bk_island *island, double t, const double *y, double
     const bk_model *model = scene->model;
     double driver_pos = bk_driver_position(&model->driver, t);
     double driver_force_sum = 0.0;
-    double dissipation_rate = 0.0;
+    double dissipation_rate = 0.0, damping_rate = 0.0;
     double *state_rates = f_implicit ? f_implicit : ydot;
     if (f_implicit)
         memset(f_implicit, 0, island->n_y * sizeof *f_implicit);
@@ -260,17 +295,19 @@ static void rhs_parts(const bk_island *island, double t, const double *y, double
         double dir = (double)scene->mode[i];
         double spring = driver_force(scene, i, x_i, driver_pos);
         double applied = spring + coupling_force(island, y, i, x_i);
+        double dashpots = damping_force(island, y, i, v_i);
         double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
                                                 block_state(island, y, i));
         ydot[s] = v_i;
         if (f_implicit) {
             ydot[s + 1] = applied / b->mass;
-            f_implicit[s + 1] = -dir * friction / b->mass;
+            f_implicit[s + 1] = (dashpots - dir * friction) / b->mass;
         } else {
-            ydot[s + 1] = (applied - dir * friction) / b->mass;
+            ydot[s + 1] = (applied + dashpots - dir * friction) / b->mass;
         }
         driver_force_sum += spring;
         dissipation_rate += dir * friction * v_i;
+        damping_rate -= v_i * dashpots;
     }
     if (scene->full_layout)
         for (size_t k = 0; k < island->len; ++k) {
@@ -279,6 +316,7 @@ static void rhs_parts(const bk_island *island, double t, const double *y, double
                 size_t s = scene->slot[i];
                 ydot[s] = y[s + 1];       /* xi' = v */
                 ydot[s + 1] = -y[s + 1]; /* 0 = -v, algebraic */
+                damping_rate -= y[s + 1] * damping_force(island, y, i, y[s + 1]);
             }
         }
     for (size_t k = 0; k < island->n_stateful; ++k) {
@@ -293,8 +331,11 @@ static void rhs_parts(const bk_island *island, double t, const double *y, double
             for (size_t j = 0; j < b->law->n_state; ++j)
                 ydot[scene->state_slot[i] + j] = 0.0;
     }
-    ydot[island->n_y - 2] = bk_driver_velocity(&model->driver, t) * driver_force_sum;
-    ydot[island->n_y - 1] = dissipation_rate;
+    double *energy_rates = &ydot[island->n_y - scene->n_energy];
+    energy_rates[0] = bk_driver_velocity(&model->driver, t) * driver_force_sum;
+    energy_rates[1] = dissipation_rate;
+    if (scene->damped)
+        energy_rates[2] = damping_rate;
 }
 
 int bk_island_rhs(double t, const double *y, double *ydot, void *user)
@@ -332,7 +373,28 @@ static void friction_derivatives(const bk_scene *scene, size_t i, double slip_ra
     *d_state = (up - down) / (2.0 * hs);
 }
 
-/* The Jacobian of the whole right-hand side, or (friction_only) of its friction part. */
+/* The dashpots' part for block i (integrated at slot s): d accel / d v of it and of its
+ * partners here, and the dissipation rate's d / d v_i = -2 G_i (see rhs_parts). */
+static void damping_jacobian(const bk_island *island, const double *y, size_t i, size_t s, int with_energy,
+                             void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
+{
+    const bk_scene *scene = island->scene;
+    const bk_model *model = scene->model;
+    double etac = model->coupling_damping, m = model->blocks[i].mass;
+    if (!bk_scene_stuck(scene, i)) {
+        put(matrix, s + 1, s + 1, -(model->blocks[i].damping + etac * bk_model_coupling_count(model, i)) / m);
+        const long partners[2] = {scene->left[i], scene->right[i]};
+        for (size_t p = 0; p < 2 && etac > 0.0; ++p)
+            if (partners[p] >= 0 && scene->slot[partners[p]] != BK_NO_SLOT &&
+                scene->island_of[partners[p]] == island->id)
+                put(matrix, s + 1, scene->slot[partners[p]] + 1, etac / m);
+    }
+    if (with_energy)
+        put(matrix, island->n_y - 1, s + 1, -2.0 * damping_force(island, y, i, y[s + 1]));
+}
+
+/* The Jacobian of the whole right-hand side, or (friction_only) of its friction and dashpot
+ * part. */
 static void jacobian_parts(const bk_island *island, double t, const double *y, int friction_only,
                            void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
 {
@@ -340,7 +402,7 @@ static void jacobian_parts(const bk_island *island, double t, const double *y, i
     const bk_model *model = scene->model;
     double kc = model->coupling_stiffness;
     double speed = bk_driver_velocity(&model->driver, t);
-    size_t work_row = island->n_y - 2, dissipation_row = island->n_y - 1;
+    size_t work_row = island->n_y - scene->n_energy, dissipation_row = work_row + 1;
     for (size_t k = 0; k < island->n_active; ++k) {
         size_t i = island->active[k], s = scene->slot[i];
         const bk_block *b = &model->blocks[i];
@@ -363,6 +425,8 @@ static void jacobian_parts(const bk_island *island, double t, const double *y, i
         put(matrix, s + 1, s + 1, -d_rate / m);
         if (state)
             put(matrix, s + 1, scene->state_slot[i], -dir * d_state / m);
+        if (scene->damped)
+            damping_jacobian(island, y, i, s, !friction_only, put, matrix);
         if (friction_only)
             continue;
         /* Energy rates: driver power V k (D - x), friction power dir F v. */
@@ -379,6 +443,8 @@ static void jacobian_parts(const bk_island *island, double t, const double *y, i
                 size_t s = scene->slot[i];
                 put(matrix, s, s + 1, 1.0);
                 put(matrix, s + 1, s + 1, -1.0);
+                if (scene->damped)
+                    damping_jacobian(island, y, i, s, 1, put, matrix);
             }
         }
     /* State equations: d(rate)/d(state) and, while slipping, d(rate)/dv. */
@@ -430,7 +496,8 @@ int bk_island_roots(double t, const double *y, double *g, void *user)
         const bk_block *b = &model->blocks[i];
         double *gi = &g[R * k];
         double x_i = position(island, y, (long)i);
-        double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i);
+        double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) +
+                         damping_force(island, y, i, velocity(island, y, (long)i));
         const double *state = block_state(island, y, i);
         size_t s = scene->slot[i];
         if (!scene->can_stick[i]) {
@@ -467,7 +534,8 @@ double bk_island_slip_acceleration(const bk_island *island, size_t i, double t, 
     double driver_pos = bk_driver_position(&scene->model->driver, t);
     double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
     double dir = (double)scene->mode[i];
-    double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i);
+    double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) +
+                     damping_force(island, y, i, v_i);
     double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
                                             block_state(island, y, i));
     return dir * (applied - dir * friction) / b->mass;

@@ -92,6 +92,32 @@ double bk_model_applied_force(const bk_model *model, size_t i, const double *x, 
     return bk_model_driver_force(model, i, x[i], driver_pos) + bk_model_coupling_force(model, i, x);
 }
 
+double bk_model_damping_force(const bk_model *model, size_t i, const double *v)
+{
+    double force = -model->blocks[i].damping * v[i];
+    double etac = model->coupling_damping;
+    if (etac == 0.0)
+        return force;
+    long left, right;
+    bk_model_neighbours(model, i, &left, &right);
+    if (left != -1)
+        force += etac * ((left >= 0 ? v[left] : 0.0) - v[i]);
+    if (right != -1)
+        force += etac * ((right >= 0 ? v[right] : 0.0) - v[i]);
+    return force;
+}
+
+int bk_model_is_damped(const bk_model *model)
+{
+    /* Coupling dashpots exist where coupling springs do: between blocks, or to fixed walls. */
+    if (model->coupling_damping > 0.0 && (model->n_blocks > 1 || model->boundary == BK_BOUNDARY_FIXED))
+        return 1;
+    for (size_t i = 0; i < model->n_blocks; ++i)
+        if (model->blocks[i].damping > 0.0)
+            return 1;
+    return 0;
+}
+
 double bk_model_elastic_energy(const bk_model *model, const double *x, double driver_pos)
 {
     size_t n = model->n_blocks;

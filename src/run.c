@@ -347,7 +347,7 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
     ctx.t_row_due = NAN;
     ctx.max_bytes = config->output.max_bytes > 0.0 ? config->output.max_bytes : INFINITY;
     ctx.row_bytes = bk_output_row_bytes(config->output.fields, config->model->n_blocks,
-                                        config->model->n_friction_state);
+                                        config->model->n_friction_state, bk_model_is_damped(config->model));
     ctx.t_instant = NAN;
     memset(ctx.stats, 0, sizeof *ctx.stats);
     snprintf(ctx.stats->method, sizeof ctx.stats->method, "%s", config->solver.method);
@@ -420,21 +420,24 @@ done:
     if (ctx.scene.x && ctx.spring_energy_ref) {
         bk_run_stats *st = ctx.stats;
         double d = bk_driver_position(&ctx.model->driver, ctx.t_last_row);
-        st->work_driver = ctx.work;
-        st->dissipation = ctx.dissipation;
+        st->work_driver = ctx.total.work;
+        st->dissipation = ctx.total.friction;
+        st->damping_dissipation = ctx.total.damping;
         st->elastic_change = bk_model_elastic_energy(ctx.model, ctx.scene.x, d) - ctx.elastic0;
         st->kinetic_change = bk_model_kinetic_energy(ctx.model, ctx.scene.v) - ctx.kinetic0;
-        double scale = fmax(fmax(fabs(st->work_driver), fabs(st->dissipation)),
-                            fmax(fabs(st->elastic_change), fabs(st->kinetic_change)));
-        double residual = st->work_driver - st->elastic_change - st->kinetic_change - st->dissipation;
+        double scale = fmax(fmax(fmax(fabs(st->work_driver), fabs(st->dissipation)),
+                                 fmax(fabs(st->elastic_change), fabs(st->kinetic_change))),
+                            fabs(st->damping_dissipation));
+        double residual = st->work_driver - st->elastic_change - st->kinetic_change - st->dissipation -
+                          st->damping_dissipation;
         st->energy_residual = scale > 0.0 ? residual / scale : 0.0;
         if (rc == BK_OK && !isfinite(st->energy_residual))
             rc = BK_FAIL(err, BK_ERR_NUMERIC,
                          "the energy audit overflowed at t = %.17g s (driver work %g J, elastic change %g J, "
-                         "kinetic change %g J, dissipation %g J): the motion's scale is beyond double "
-                         "precision",
+                         "kinetic change %g J, dissipation %g J, by dashpots %g J): the motion's scale is "
+                         "beyond double precision",
                          ctx.t_last_row, st->work_driver, st->elastic_change, st->kinetic_change,
-                         st->dissipation);
+                         st->dissipation, st->damping_dissipation);
     }
     free_ctx(&ctx);
     return rc;

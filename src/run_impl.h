@@ -74,9 +74,9 @@ typedef struct run_ctx {
 
     /* Energy bookkeeping: what finished, and each stuck block's driver-spring energy when its
      * stuck interval began (the driver's work on a stuck block is that spring's gain). */
-    double work_closed, dissipation_closed; /* J */
+    bk_energy closed;        /* J */
     double *spring_energy_ref;             /* J, per block */
-    double work, dissipation;              /* J, totals at the last unpack_all */
+    bk_energy total;         /* J, totals at the last unpack_all */
 
     /* Transitions of the current instant, flushed in block order when it ends. */
     bk_transition *instant;
@@ -176,7 +176,7 @@ int bk_run_quiet_failures(run_ctx *ctx, double t);
  * breakaway time goes into the quiet queue. */
 void bk_run_make_quiet(run_ctx *ctx, size_t i, double t);
 /* Fill the chain's arrays with every island's state at t (interpolated, or the island's
- * own vector where it stands at t), and ctx->work and ctx->dissipation with the totals. */
+ * own vector where it stands at t), and ctx->total with the totals. */
 int bk_run_unpack_all(run_ctx *ctx, double t);
 /* Counters of every back-end instance so far. */
 void bk_run_solver_counters(const run_ctx *ctx, bk_solver_counters *total);
@@ -218,7 +218,7 @@ void bk_run_leave_stuck(run_ctx *ctx, size_t i, double t);
 void bk_run_enter_stuck(run_ctx *ctx, size_t i, double t);
 /* Driver work and dissipation at t from the closed totals, the islands' increments and the
  * stuck blocks' springs (J); the islands' increments are given. */
-void bk_run_energy_totals(run_ctx *ctx, double t, double island_work, double island_dissipation);
+void bk_run_energy_totals(run_ctx *ctx, double t, const bk_energy *islands);
 /* Statistics so far, the resumed run's included. */
 void bk_run_collect_stats(const run_ctx *ctx, bk_run_stats *stats, double cpu0);
 /* The state at a checkpoint time t (islands stopped there): recorded when the wall-clock

@@ -290,8 +290,7 @@ static int start_island(run_ctx *ctx, size_t id, double t)
 /* The island's state at t into the chain's arrays: its own vector where it stands at t,
  * else dense output (t lies in its last step: see the scheduler in run.c); for an output
  * row (for_row), the back-end's output-row interpolant where it has one. */
-static int unpack_island(run_ctx *ctx, run_island *isl, double t, int for_row, double *work,
-                         double *dissipation)
+static int unpack_island(run_ctx *ctx, run_island *isl, double t, int for_row, bk_energy *increments)
 {
     const double *y = isl->y;
     if (t != isl->t_reached) {
@@ -302,25 +301,24 @@ static int unpack_island(run_ctx *ctx, run_island *isl, double t, int for_row, d
             return rc;
         y = isl->y_probe;
     }
-    bk_island_unpack(&isl->island, t, y, work, dissipation);
+    bk_island_unpack(&isl->island, t, y, increments);
     return BK_OK;
 }
 
 int bk_run_unpack_all(run_ctx *ctx, double t)
 {
-    double work = 0.0, dissipation = 0.0;
+    bk_energy islands = {0};
     for (size_t id = 0; id < ctx->islands_used; ++id) {
         run_island *isl = ctx->islands[id];
         if (!isl->live)
             continue;
-        double w, d;
-        int rc = unpack_island(ctx, isl, t, 1, &w, &d);
+        bk_energy increments;
+        int rc = unpack_island(ctx, isl, t, 1, &increments);
         if (rc != BK_OK)
             return rc;
-        work += w;
-        dissipation += d;
+        bk_energy_add(&islands, &increments);
     }
-    bk_run_energy_totals(ctx, t, work, dissipation);
+    bk_run_energy_totals(ctx, t, &islands);
     return BK_OK;
 }
 
@@ -344,12 +342,11 @@ static int dissolve(run_ctx *ctx, size_t id, double t, int taken)
 {
     run_island *isl = ctx->islands[id];
     if (!taken) {
-        double work, dissipation;
-        int rc = unpack_island(ctx, isl, t, 0, &work, &dissipation);
+        bk_energy increments;
+        int rc = unpack_island(ctx, isl, t, 0, &increments);
         if (rc != BK_OK)
             return rc;
-        ctx->work_closed += work;
-        ctx->dissipation_closed += dissipation;
+        bk_energy_add(&ctx->closed, &increments);
     }
     bk_scene *scene = &ctx->scene;
     for (size_t k = 0; k < isl->island.len; ++k) {
@@ -665,12 +662,11 @@ int bk_run_island_event(run_ctx *ctx, size_t id)
     const bk_scene *scene = &ctx->scene;
     size_t R = scene->roots_per_block;
     double t = isl->t_event;
-    double work, dissipation;
-    int rc = unpack_island(ctx, isl, t, 0, &work, &dissipation);
+    bk_energy increments;
+    int rc = unpack_island(ctx, isl, t, 0, &increments);
     if (rc != BK_OK)
         return rc;
-    ctx->work_closed += work;
-    ctx->dissipation_closed += dissipation;
+    bk_energy_add(&ctx->closed, &increments);
     const bk_island *island = &isl->island;
     /* Every root restarts the island.  A minimum that hid no stop disarms its root until the
      * block decelerates again, so the restart does not begin on a zero of it. */

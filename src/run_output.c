@@ -56,8 +56,9 @@ static int send_row(run_ctx *ctx, double t, bk_row_kind kind)
         .friction_state = model->n_friction_state ? ctx->state_out : NULL,
         .kinetic_energy = bk_model_kinetic_energy(model, scene->v),
         .elastic_energy = bk_model_elastic_energy(model, scene->x, driver_pos),
-        .work_driver = ctx->work,
-        .dissipation = ctx->dissipation,
+        .work_driver = ctx->total.work,
+        .dissipation = ctx->total.friction,
+        .damping_dissipation = ctx->total.damping,
         .is_event = (int)kind,
     };
     ctx->t_last_row = t;
@@ -196,7 +197,7 @@ int bk_run_flush_instant(run_ctx *ctx)
 void bk_run_leave_stuck(run_ctx *ctx, size_t i, double t)
 {
     double driver_pos = bk_driver_position(&ctx->model->driver, t);
-    ctx->work_closed += bk_scene_driver_spring_energy(&ctx->scene, i, driver_pos) - ctx->spring_energy_ref[i];
+    ctx->closed.work += bk_scene_driver_spring_energy(&ctx->scene, i, driver_pos) - ctx->spring_energy_ref[i];
 }
 
 void bk_run_enter_stuck(run_ctx *ctx, size_t i, double t)
@@ -205,7 +206,7 @@ void bk_run_enter_stuck(run_ctx *ctx, size_t i, double t)
     ctx->spring_energy_ref[i] = bk_scene_driver_spring_energy(&ctx->scene, i, driver_pos);
 }
 
-void bk_run_energy_totals(run_ctx *ctx, double t, double island_work, double island_dissipation)
+void bk_run_energy_totals(run_ctx *ctx, double t, const bk_energy *islands)
 {
     const bk_scene *scene = &ctx->scene;
     double driver_pos = bk_driver_position(&ctx->model->driver, t);
@@ -213,15 +214,15 @@ void bk_run_energy_totals(run_ctx *ctx, double t, double island_work, double isl
     for (size_t i = 0; i < scene->n; ++i)
         if (bk_scene_stuck(scene, i))
             open += bk_scene_driver_spring_energy(scene, i, driver_pos) - ctx->spring_energy_ref[i];
-    ctx->work = ctx->work_closed + island_work + open;
-    ctx->dissipation = ctx->dissipation_closed + island_dissipation;
+    ctx->total = ctx->closed;
+    bk_energy_add(&ctx->total, islands);
+    ctx->total.work += open;
 }
 
 void bk_run_rebase_energy(run_ctx *ctx, double t)
 {
     bk_scene *scene = &ctx->scene;
-    ctx->work_closed = ctx->work;
-    ctx->dissipation_closed = ctx->dissipation;
+    ctx->closed = ctx->total;
     for (size_t i = 0; i < scene->n; ++i)
         if (bk_scene_stuck(scene, i)) {
             bk_run_enter_stuck(ctx, i, t);
@@ -272,8 +273,9 @@ int bk_run_checkpoint(run_ctx *ctx, double t)
             .last_transition = ctx->last_transition,
             .instant_count = ctx->instant_count,
             .next_sample = ctx->next_sample,
-            .work_driver = ctx->work,
-            .dissipation = ctx->dissipation,
+            .work_driver = ctx->total.work,
+            .dissipation = ctx->total.friction,
+            .damping_dissipation = ctx->total.damping,
             .elastic_initial = ctx->elastic0,
             .kinetic_initial = ctx->kinetic0,
             .t_last_row = ctx->t_last_row,
@@ -310,8 +312,7 @@ int bk_run_resume(run_ctx *ctx, const bk_checkpoint *cp)
     memcpy(ctx->instant_count, cp->instant_count, n * sizeof *ctx->instant_count);
     for (size_t i = 0; i < n; ++i)
         scene->state_time[i] = cp->t;
-    ctx->work = cp->work_driver;
-    ctx->dissipation = cp->dissipation;
+    ctx->total = (bk_energy){cp->work_driver, cp->dissipation, cp->damping_dissipation};
     bk_run_rebase_energy(ctx, cp->t);
     ctx->elastic0 = cp->elastic_initial;
     ctx->kinetic0 = cp->kinetic_initial;

@@ -40,9 +40,11 @@ int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
         bk_scene_free(scene);
         return -1;
     }
-    /* Stateless constant-force laws and a constant-velocity driver make every frozen-mode
-     * segment linear with constant coefficients. */
-    scene->affine = bk_model_is_affine(model);
+    /* Stateless constant-force laws, no dashpots and a constant-velocity driver make every
+     * frozen-mode segment affine, with forces independent of velocity (the exact stepper). */
+    scene->damped = bk_model_is_damped(model);
+    scene->affine = bk_model_is_affine(model) && !scene->damped;
+    scene->n_energy = scene->damped ? 3 : 2;
     for (size_t i = 0; i < n; ++i) {
         const bk_block *b = &model->blocks[i];
         scene->normal[i] = b->normal_force;
@@ -91,7 +93,8 @@ static const double *stored_state(const bk_scene *scene, size_t i)
 
 double bk_scene_applied_force(const bk_scene *scene, size_t i, double driver_pos)
 {
-    return bk_model_applied_force(scene->model, i, scene->x, driver_pos);
+    double force = bk_model_applied_force(scene->model, i, scene->x, driver_pos);
+    return scene->damped ? force + bk_model_damping_force(scene->model, i, scene->v) : force;
 }
 
 double bk_scene_static_threshold(const bk_scene *scene, size_t i)

@@ -11,8 +11,9 @@
  * An island's integrated vector is, in chain order, per block: [xi, v] if slipping (xi =
  * x - x_ref, the slip since the island's restart, so the integrator's error scales with the
  * slip, not the absolute position), then the block's friction state if its law has any; and
- * last two energy increments since the restart: the driver work on its slipping blocks and
- * their frictional dissipation.  Stuck blocks keep x = x_ref, v = 0.
+ * last the energy increments since the restart: the driver work on its slipping blocks, their
+ * frictional dissipation and, with dashpots, the dashpots' dissipation (scene->n_energy).
+ * Stuck blocks keep x = x_ref, v = 0.
  *
  * The full layout (full_layout set; only for a back-end that asks, IDA) keeps [xi, v] of an
  * island's stuck blocks too, as rows xi' = v (differential) and 0 = -v (algebraic: the
@@ -60,7 +61,11 @@ typedef struct bk_scene {
                                 minimum: it never starts at or hovers around zero (a slip
                                 that starts with zero acceleration, steady sliding). */
     int full_layout;         /* islands keep their stuck blocks in y (see above) */
-    int affine;              /* every law Coulomb-like: islands' ODEs are affine in y and t */
+    int affine;              /* every law Coulomb-like, no dashpots: islands' ODEs are affine in y
+                                and t, accelerations independent of velocities */
+    int damped;              /* some dashpot (bk_model_is_damped) */
+    size_t n_energy;         /* energy increments at the end of an island's y: driver work, friction
+                                dissipation and, when damped, dashpot dissipation */
     size_t *slot;            /* per block: index of xi in its island's y, or BK_NO_SLOT */
     size_t *state_slot;      /* per block: index of its first friction state in its island's y */
     size_t *island_of;       /* per block: its island, or BK_NO_ISLAND (quiet) */
@@ -81,7 +86,8 @@ static inline int bk_scene_stuck(const bk_scene *scene, size_t i)
     return scene->mode[i] == BK_MODE_STICK;
 }
 
-/* Applied (spring) force on block i with the unpacked positions at driver position D. */
+/* Applied force on block i, springs and dashpots, with the unpacked positions and velocities at
+ * driver position D. */
 double bk_scene_applied_force(const bk_scene *scene, size_t i, double driver_pos);
 /* Static threshold of block i (N) with its stored friction state. */
 double bk_scene_static_threshold(const bk_scene *scene, size_t i);
@@ -98,6 +104,20 @@ void bk_scene_age(bk_scene *scene, size_t i, double t);
 /* Energy in block i's driver spring at driver position D (J): what the driver's work on a
  * stuck block adds up to. */
 double bk_scene_driver_spring_energy(const bk_scene *scene, size_t i, double driver_pos);
+
+/* Energies the run integrates rather than reads off the state (J). */
+typedef struct bk_energy {
+    double work;     /* done by the driver */
+    double friction; /* dissipated by friction */
+    double damping;  /* dissipated by the dashpots */
+} bk_energy;
+
+static inline void bk_energy_add(bk_energy *sum, const bk_energy *more)
+{
+    sum->work += more->work;
+    sum->friction += more->friction;
+    sum->damping += more->damping;
+}
 
 /* An island: blocks start, start + 1, ..., start + len - 1 of the chain (mod n). */
 typedef struct bk_island {
@@ -148,10 +168,9 @@ void bk_island_tolerances(const bk_island *island, double atol_x, double atol_v,
 void bk_island_arm(bk_island *island, double t, const double *y);
 /* Slip acceleration s a of slipping block i for the integrated vector y (m/s^2). */
 double bk_island_slip_acceleration(const bk_island *island, size_t i, double t, const double *y);
-/* Fill x, v and state of the island's blocks from y at time t; *work and *dissipation (may
- * be NULL) receive the energy increments since the restart (J). */
-void bk_island_unpack(bk_island *island, double t, const double *y, double *work,
-                      double *dissipation);
+/* Fill x, v and state of the island's blocks from y at time t; *increments (may be NULL)
+ * receives the energy increments since the restart. */
+void bk_island_unpack(bk_island *island, double t, const double *y, bk_energy *increments);
 
 /* The ODE right-hand side and root functions of an island (bk_ode_problem, user = island);
  * in the full layout f of the semi-explicit DAE, a stuck block's velocity row being -v.

@@ -20,6 +20,9 @@
 #define TIME_FACTOR 30.0
 /* 10-block chain: |energy residual| <= ENERGY_FACTOR * rtol (measured worst: 0.4 rtol). */
 #define ENERGY_FACTOR 100.0
+/* The damped single block: measured worst 24 rtol (cvode_bdf at zeta 0.7), the Runge-Kutta
+ * back-ends below 1.2 rtol. */
+#define DAMPED_TIME_FACTOR 60.0
 
 static void run_config(bk_config *c, recorder *r, bk_run_stats *stats)
 {
@@ -133,32 +136,148 @@ static void test_case_c(void **state)
     exact_free(&ex);
 }
 
+/* --- the damped single block against its closed form ----------------------------------- */
+
+#define PI_VALUE 3.14159265358979323846
+
+/* The paper's block with a dashpot c to the substrate, case A friction.  From rest at
+ * spring extension F_s / k it slips, m x'' = k (V t - x) - c x' - F_d, i.e. about the
+ * particular solution x_p = V t - (F_d + c V) / k the deviation u = x - x_p rings down as
+ * u'' + 2 zeta w u' + w^2 u = 0, and the slip ends where the underdamped velocity
+ * V + u'(tau) first returns to zero.  Then the block sticks until the spring is back at
+ * F_s: every cycle repeats the first, so one slip duration and slip length give every
+ * transition time. */
+typedef struct damped_cycle {
+    double t_first;  /* s, first breakaway */
+    double slip_time; /* s */
+    double slip;     /* m */
+    double stuck_time; /* s */
+} damped_cycle;
+
+static double damped_velocity(double V, double zw, double wd, double A, double B, double tau)
+{
+    double e = exp(-zw * tau);
+    return V + e * ((-zw * A + wd * B) * cos(wd * tau) + (-zw * B - wd * A) * sin(wd * tau));
+}
+
+static damped_cycle damped_closed_form(double m, double k, double c, double V, double f_s, double f_d)
+{
+    double w = sqrt(k / m), zeta = c / (2.0 * m * w), zw = zeta * w, wd = w * sqrt(1.0 - zeta * zeta);
+    double A = (f_d - f_s + c * V) / k, B = (-V + zw * A) / wd;
+    /* v > 0 just after the breakaway (a = (F_s - F_d) / m); scan for its first sign change. */
+    double h = 1e-3 * PI_VALUE / wd, lo = h, hi = 2.0 * h;
+    while (damped_velocity(V, zw, wd, A, B, hi) > 0.0) {
+        lo = hi;
+        hi += h;
+        assert_true(hi < 10.0 * PI_VALUE / wd);
+    }
+    for (int it = 0; it < 200; ++it) {
+        double mid = 0.5 * (lo + hi);
+        if (damped_velocity(V, zw, wd, A, B, mid) > 0.0)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    damped_cycle cycle = {.t_first = f_s / (k * V), .slip_time = 0.5 * (lo + hi)};
+    double tau = cycle.slip_time, e = exp(-zw * tau);
+    double u = e * (A * cos(wd * tau) + B * sin(wd * tau));
+    /* Slip from x = x_p + u, measured from the position at breakaway (x_p(0) + A there). */
+    cycle.slip = V * tau + u - A;
+    double extension = f_s / k - cycle.slip + V * tau; /* D - x at the stop */
+    cycle.stuck_time = (f_s / k - extension) / V;
+    return cycle;
+}
+
+/* Every integrator back-end against the closed form at two damping ratios, every
+ * transition time to TIME_FACTOR * rtol; the exact stepper refuses (its modes ring without
+ * decay) with a message naming what to use. */
+static void test_damped_single_block(void **state)
+{
+    (void)state;
+    const double zetas[] = {0.1, 0.7};
+    const double rtol = 1e-10, m = 1.0, k = 1e4, V = 1e-3, f_s = 0.6 * 9.81, f_d = 0.1 * 9.81;
+    header();
+    for (size_t z = 0; z < 2; ++z) {
+        double c = 2.0 * zetas[z] * sqrt(k * m);
+        damped_cycle cycle = damped_closed_form(m, k, c, V, f_s, f_d);
+        for (const bk_solver_backend *const *b = bk_solver_backends(); *b; ++b) {
+            scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, rtol, (*b)->name);
+            spec.t_end = 3.0;
+            bk_config *cfg = scene_config(&spec);
+            cfg->model->blocks[0].damping = c;
+            recorder r = {0};
+            bk_run_stats stats;
+            bk_error err = {0};
+            int rc = run_recorded(cfg, &r, &stats, &err);
+            if (strcmp((*b)->name, "exact") == 0) {
+                assert_int_equal(rc, BK_ERR_CONFIG);
+                assert_non_null(strstr(err.message, "damping"));
+                assert_non_null(strstr(err.message, "cvode_bdf"));
+            } else {
+                if (rc != BK_OK)
+                    print_error("%s: %s\n", (*b)->name, err.message);
+                assert_int_equal(rc, BK_OK);
+                assert_false(r.time_decreased);
+                assert_true(r.n_transitions >= 4);
+                double worst = 0.0, period = cycle.slip_time + cycle.stuck_time;
+                for (size_t j = 0; j < r.n_transitions; ++j) {
+                    size_t n_cycle = j / 2;
+                    int breakaway = j % 2 == 0;
+                    double t = cycle.t_first + (double)n_cycle * period + (breakaway ? 0.0 : cycle.slip_time);
+                    assert_int_equal(r.transitions[j].to, breakaway ? BK_MODE_SLIP_POS : BK_MODE_STICK);
+                    worst = fmax(worst, fabs(r.transitions[j].t - t) / t);
+                    if (!breakaway)
+                        assert_close(r.transitions[j].x, (double)(n_cycle + 1) * cycle.slip, 1e3 * rtol, 0);
+                }
+                row((*b)->name, zetas[z] < 0.5 ? "zeta.1" : "zeta.7", rtol, &stats, "dt/t", worst);
+                assert_true(worst <= DAMPED_TIME_FACTOR * rtol);
+                /* The dashpots' share of the energy audit: work = dE + friction + dashpots. */
+                assert_true(stats.damping_dissipation > 0.0);
+                assert_true(fabs(stats.energy_residual) <= ENERGY_FACTOR * rtol);
+            }
+            recorder_free(&r);
+            bk_config_free(cfg);
+        }
+    }
+}
+
 /* A 10-block chain (coupled, asymmetric start, mixed mu_d): driver work = elastic +
  * kinetic energy change + dissipation, to ENERGY_FACTOR * rtol; every back-end with a
  * dense linear solver, and the implicit ones with a band solver too (the analytic Jacobian
  * keeps the energy quadratures' rows, which depend on every block, out of the band; a
  * band difference-quotient Jacobian would spill them into it: README, Solver back-ends). */
-static void chain_energy(const char *method, const char *linear_solver)
+static void chain_energy(const char *method, const char *linear_solver, int damped)
 {
     const double rtol = 1e-8;
     {
         scene_spec spec = paper_case(0.5, BK_SPRING_LINEAR, rtol, method);
         spec.n = 10;
         spec.coupling = 2e4;
-        spec.t_end = 3.0;
+        spec.t_end = damped ? 1.5 : 3.0;
+        /* Damped: fixed ends, so the coupling dashpots pull on walls too. */
+        if (damped)
+            spec.boundary = BK_BOUNDARY_FIXED;
         bk_config *c = scene_config(&spec);
         snprintf(c->solver.linear_solver, sizeof c->solver.linear_solver, "%s", linear_solver);
         for (size_t i = 0; i < spec.n; ++i) {
             c->model->blocks[i].x_init = 1e-5 * sin(2.385 * (double)i);
             c->model->blocks[i].friction_params[1] = 0.45 + 0.01 * (double)(i % 5);
+            if (damped)
+                c->model->blocks[i].damping = 2.0 + 0.5 * (double)(i % 3);
         }
+        if (damped)
+            c->model->coupling_damping = 6.0;
         recorder r = {0};
         bk_run_stats stats;
         run_config(c, &r, &stats);
-        row(method, linear_solver[0] == 'b' ? "chain10b" : "chain10", rtol, &stats, "energy",
-            fabs(stats.energy_residual));
+        row(method, damped ? "damped10" : linear_solver[0] == 'b' ? "chain10b" : "chain10", rtol, &stats,
+            "energy", fabs(stats.energy_residual));
         assert_true(r.n_transitions > 2 * spec.n);
         assert_true(stats.work_driver > 0.0);
+        /* The dashpots take a share the audit must count: without it the residual would be
+         * that share over the work. */
+        if (damped)
+            assert_true(stats.damping_dissipation > 1e3 * ENERGY_FACTOR * rtol * stats.work_driver);
         assert_true(fabs(stats.energy_residual) <= ENERGY_FACTOR * rtol);
         recorder_free(&r);
         bk_config_free(c);
@@ -170,10 +289,16 @@ static void test_chain_energy(void **state)
     (void)state;
     header();
     for (const bk_solver_backend *const *b = bk_solver_backends(); *b; ++b)
-        chain_energy((*b)->name, "dense");
+        chain_energy((*b)->name, "dense", 0);
     const char *implicit[] = {"cvode_bdf", "arkode_dirk", "arkode_imex", "ida"};
     for (size_t k = 0; k < sizeof implicit / sizeof implicit[0]; ++k)
-        chain_energy(implicit[k], "band");
+        chain_energy(implicit[k], "band", 0);
+    /* Dashpots to the substrate and beside the coupling springs (the exact stepper refuses
+     * them: test_damped_single_block). */
+    for (const bk_solver_backend *const *b = bk_solver_backends(); *b; ++b)
+        if (strcmp((*b)->name, "exact") != 0)
+            chain_energy((*b)->name, "dense", 1);
+    chain_energy("ida", "band", 1);
 }
 
 /* Every Butcher table [solver] arkode_table offers, through arkode_erk or arkode_dirk:
@@ -514,6 +639,7 @@ int main(void)
         cmocka_unit_test(test_samples_match_stepped),
         cmocka_unit_test(test_cases_a_b),
         cmocka_unit_test(test_case_c),
+        cmocka_unit_test(test_damped_single_block),
         cmocka_unit_test(test_chain_energy),
         cmocka_unit_test(test_arkode_tables),
         cmocka_unit_test(test_ida_two_block_chain),

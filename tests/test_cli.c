@@ -204,6 +204,9 @@ static void test_bad_inputs(void **state)
         {"velocity = 1e-3", "velocity = 1e-3\nspeed = 2", "bad.ini:12: [driver] speed:"},
         {"law = coulomb", "law = magic", "bad.ini:7: [friction] law:"},
         {"[model]", "[modle]", "bad.ini:1:"},
+        {"mass = 1", "mass = 1\ndamping = -1", "bad.ini:5: [block] damping: out of range, got -1"},
+        {"[model]", "[model]\ncoupling_damping = -3", "bad.ini:2: [model] coupling_damping: out of range, got -3"},
+        {"mass = 1", "mass = 1\ndamping = normal(1, -0.5)", "bad.ini:5: [block] damping: normal(1, -0.5) has a negative width"},
     };
     char path[512], out[512], cmd[2048], cwd[1024];
     assert_non_null(getcwd(cwd, sizeof cwd));
@@ -965,14 +968,18 @@ static void test_restart_equivalence(void **state)
 {
     (void)state;
     /* gsl_rk8pd resets its stepper when a size repeats instead of making a new one: the
-     * resumed run's fresh instances must compute what the reused ones do. */
-    const char *methods[] = {"cvode_adams", "exact", "gsl_rk8pd"};
-    for (size_t m = 0; m < 3; ++m) {
+     * resumed run's fresh instances must compute what the reused ones do.  The damped run
+     * carries its dashpot dissipation through the checkpoints. */
+    const char *methods[] = {"cvode_adams", "exact", "gsl_rk8pd", "gsl_rk8pd"};
+    const char *extra[] = {"", "", "", "--set block.damping=20"};
+    for (size_t m = 0; m < 4; ++m) {
         char reference[512], stopped[512], part[600], cmd[2048];
-        snprintf(reference, sizeof reference, "%s/reference_%s.h5", tmpdir, methods[m]);
-        snprintf(stopped, sizeof stopped, "%s/stopped_%s.h5", tmpdir, methods[m]);
+        snprintf(reference, sizeof reference, "%s/reference_%s_%zu.h5", tmpdir, methods[m], m);
+        snprintf(stopped, sizeof stopped, "%s/stopped_%s_%zu.h5", tmpdir, methods[m], m);
         snprintf(part, sizeof part, "%s.part", stopped);
-        const char *common = "configs/paper/case_b_coulomb.ini --quiet --set output.checkpoint_interval=0.1";
+        char common[512];
+        snprintf(common, sizeof common, "configs/paper/case_b_coulomb.ini --quiet --set output.checkpoint_interval=0.1 %s",
+                 extra[m]);
         snprintf(cmd, sizeof cmd, "./bksim run %s --set solver.method=%s -o %s", common, methods[m], reference);
         assert_int_equal(run_command(cmd, NULL), 0);
         /* The same run under a wall-clock limit so short that it stops many times (each

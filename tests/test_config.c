@@ -58,6 +58,35 @@ static const char *const minimal_config =
     "[driver]\nvelocity = 1e-3\n"
     "[run]\nt_end = 5\n";
 
+/* Dashpot keys: per block (with [block.I] and distributions) and beside the couplings. */
+static void test_damping_keys(void **state)
+{
+    (void)state;
+    char text[1024];
+    snprintf(text, sizeof text, "%s", minimal_config);
+    char *n = strstr(text, "n_blocks = 1");
+    n[11] = '3';
+    strcat(text, "[model]\ncoupling_damping = 2.5\n[block.1]\ndamping = 0.75\n");
+    const char *overrides[] = {"block.damping=uniform(1, 2)"};
+    bk_config *c = NULL;
+    bk_error err = {0};
+    int rc = bk_config_load_string(text, "d.ini", overrides, 1, &c, &err);
+    if (rc != BK_OK)
+        fail_msg("%s", err.message);
+    assert_close(c->model->coupling_damping, 2.5, 0, 0);
+    assert_close(c->model->blocks[1].damping, 0.75, 0, 0);
+    for (size_t i = 0; i < 3; i += 2)
+        assert_true(c->model->blocks[i].damping >= 1.0 && c->model->blocks[i].damping <= 2.0);
+    assert_true(bk_model_is_damped(c->model));
+    assert_true(c->model->blocks[0].damping != c->model->blocks[2].damping);
+    bk_config_free(c);
+    /* A prescribed scene imposes the slip rate: a dashpot there is a mistake. */
+    const char *prescribed = "[prescribed]\nslip_rates = 1e-6\ndurations = 10\n[friction]\nlaw = rate_state\n"
+                             "[block]\ndamping = 3\n";
+    assert_int_equal(bk_config_load_string(prescribed, "p.ini", NULL, 0, &c, &err), BK_ERR_CONFIG);
+    assert_non_null(strstr(err.message, "p.ini:7: [block] damping: a prescribed scene imposes the slip rate"));
+}
+
 static void test_full_config(void **state)
 {
     (void)state;
@@ -328,7 +357,7 @@ static void test_rejections(void **state)
          "t.ini:1: [modle]: unknown section (allowed: model, block, block.I, friction, friction.I, driver, "
          "solver, output, run; I is a block index from 0)"},
         {"mass = 1\n", "mass = 1\nmas = 2\n",
-         "t.ini:5: [block] mas: unknown key (allowed: mass, driver_stiffness, normal_force, x_init, v_init, x_init_random)"},
+         "t.ini:5: [block] mas: unknown key (allowed: mass, driver_stiffness, normal_force, x_init, v_init, x_init_random, damping)"},
         {"mass = 1\n", "mass = 1\nmass = 2\n", "t.ini:5: [block] mass: duplicate key (first set at line 4)"},
         {"n_blocks = 1\n", "", "t.ini: [model] n_blocks: required key missing (allowed: 1 <= n_blocks <= 1000000, an integer)"},
         {"mass = 1\n", "", "t.ini: [block] mass: required key missing (allowed: 0 < mass < inf kg)"},
@@ -421,6 +450,14 @@ static void test_rejections(void **state)
         {"mu_d = 0.5\n", "mu_d = uniform(0.7, 0.8)\n",
          "t.ini:9: [friction] mu_d: must be <= mu_s (0.6), got 0.7"},
         {"mu_d = 0.5\n", "mu_d = uniform(0.7, 0.8)\n", "(drawn for block 0)"},
+        /* Dashpots. */
+        {"mass = 1\n", "mass = 1\ndamping = -2\n",
+         "t.ini:5: [block] damping: out of range, got -2 (allowed: 0 <= damping < inf N s/m)"},
+        {"n_blocks = 1\n", "n_blocks = 1\ncoupling_damping = -0.5\n",
+         "t.ini:3: [model] coupling_damping: out of range, got -0.5 (allowed: 0 <= coupling_damping < inf N s/m)"},
+        {"t_end = 5\n", "t_end = 5\n[solver]\nmethod = exact\n[block.0]\ndamping = 1\n",
+         "t.ini:15: [solver] method: solves motion whose forces do not depend on velocity; [block] damping or "
+         "[model] coupling_damping makes them (allowed: auto, which picks an integrator here"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         char text[4096];
@@ -700,6 +737,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_full_config),
+        cmocka_unit_test(test_damping_keys),
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(test_checkpoint_keys),
         cmocka_unit_test(test_distributions),

@@ -59,29 +59,33 @@ static void test_row_bytes(void **state)
 {
     (void)state;
     /* time 8 + driver 8 + event 1; per block x v friction cof 8 each and mode 1; four
-     * energies 8 each; each friction state 8. */
-    assert_close(bk_output_row_bytes(BK_FIELD_ALL, 3, 4), 17.0 + 3 * 33.0 + 32.0 + 32.0, 0, 0);
-    assert_close(bk_output_row_bytes(BK_FIELD_X | BK_FIELD_MODE, 1000, 0), 17.0 + 9000.0, 0, 0);
-    assert_close(bk_output_row_bytes(0, 1000, 5), 17.0, 0, 0);
+     * energies 8 each (five with dashpots); each friction state 8. */
+    assert_close(bk_output_row_bytes(BK_FIELD_ALL, 3, 4, 0), 17.0 + 3 * 33.0 + 32.0 + 32.0, 0, 0);
+    assert_close(bk_output_row_bytes(BK_FIELD_ALL, 3, 4, 1), 17.0 + 3 * 33.0 + 40.0 + 32.0, 0, 0);
+    assert_close(bk_output_row_bytes(BK_FIELD_X | BK_FIELD_MODE, 1000, 0, 1), 17.0 + 9000.0, 0, 0);
+    assert_close(bk_output_row_bytes(0, 1000, 5, 0), 17.0, 0, 0);
     /* State selected but no block has any: nothing for it. */
-    assert_close(bk_output_row_bytes(BK_FIELD_STATE, 7, 0), 17.0, 0, 0);
-    assert_close(bk_output_row_bytes(BK_FIELD_STATE, 7, 2), 33.0, 0, 0);
+    assert_close(bk_output_row_bytes(BK_FIELD_STATE, 7, 0, 0), 17.0, 0, 0);
+    assert_close(bk_output_row_bytes(BK_FIELD_STATE, 7, 2, 0), 33.0, 0, 0);
 }
 
 static void test_dataset_names(void **state)
 {
     (void)state;
     char names[BK_DATASET_LIST_LEN];
-    bk_output_dataset_names(BK_FIELD_ALL, 0, 1, 0, names, sizeof names);
+    bk_output_dataset_names(BK_FIELD_ALL, 0, 0, 1, 0, names, sizeof names);
     assert_string_equal(names, "time,driver,event,x,v,friction,cof,mode,energy_kinetic,"
                                "energy_elastic,work_driver,dissipation,transitions");
-    bk_output_dataset_names(BK_FIELD_ALL, 2, 0, 1, names, sizeof names);
+    bk_output_dataset_names(BK_FIELD_ALL, 2, 0, 0, 1, names, sizeof names);
     assert_string_equal(names, "time,driver,event,x,v,friction,cof,mode,energy_kinetic,"
                                "energy_elastic,work_driver,dissipation,friction_state,events");
-    bk_output_dataset_names(BK_FIELD_ALL, 0, 1, 1, names, sizeof names);
+    bk_output_dataset_names(BK_FIELD_ALL, 0, 0, 1, 1, names, sizeof names);
     assert_string_equal(names, "time,driver,event,x,v,friction,cof,mode,energy_kinetic,"
                                "energy_elastic,work_driver,dissipation,transitions,events");
-    bk_output_dataset_names(BK_FIELD_V | BK_FIELD_STATE, 0, 0, 0, names, sizeof names);
+    bk_output_dataset_names(BK_FIELD_ALL, 0, 1, 1, 1, names, sizeof names);
+    assert_string_equal(names, "time,driver,event,x,v,friction,cof,mode,energy_kinetic,"
+                               "energy_elastic,work_driver,dissipation,damping_dissipation,transitions,events");
+    bk_output_dataset_names(BK_FIELD_V | BK_FIELD_STATE, 0, 1, 0, 0, names, sizeof names);
     assert_string_equal(names, "time,driver,event,v");
 }
 
@@ -104,7 +108,7 @@ static void test_max_bytes_guard_counts_the_table(void **state)
     int rc = bk_config_load_file("configs/chains/bk10_coulomb.ini", overrides, 5, &config, &err);
     if (rc != BK_OK)
         fail_msg("%s", err.message);
-    assert_close((double)(1000 + 1) * bk_output_row_bytes(config->output.fields, 1000, 0),
+    assert_close((double)(1000 + 1) * bk_output_row_bytes(config->output.fields, 1000, 0, 0),
                  8025017.0, 0, 0);
     bk_config_free(config);
 }

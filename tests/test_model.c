@@ -65,6 +65,50 @@ static void test_forces_fixed_and_periodic(void **state)
     bk_model_free(two_ring);
 }
 
+/* Dashpots: each block's own, and one beside every coupling spring (walls stand still);
+ * their total power -sum v_i G_i is the sum over dashpots of eta dv^2, so it never feeds
+ * energy in.  Which models count as damped. */
+static void test_damping(void **state)
+{
+    (void)state;
+    const double v[3] = {2e-3, -1e-3, 5e-3}, etac = 3.25;
+    bk_boundary boundaries[] = {BK_BOUNDARY_FREE, BK_BOUNDARY_FIXED, BK_BOUNDARY_PERIODIC};
+    for (size_t b = 0; b < 3; ++b) {
+        bk_model *m = make_chain(3, boundaries[b], BK_SPRING_LINEAR);
+        assert_false(bk_model_is_damped(m));
+        m->coupling_damping = etac;
+        assert_true(bk_model_is_damped(m));
+        for (size_t i = 0; i < 3; ++i)
+            m->blocks[i].damping = 0.5 * (double)(i + 1);
+        double power = 0.0, expected = 0.0;
+        for (size_t i = 0; i < 3; ++i) {
+            power -= v[i] * bk_model_damping_force(m, i, v);
+            expected += m->blocks[i].damping * v[i] * v[i];
+        }
+        expected += etac * ((v[1] - v[0]) * (v[1] - v[0]) + (v[2] - v[1]) * (v[2] - v[1]));
+        if (boundaries[b] == BK_BOUNDARY_FIXED)
+            expected += etac * (v[0] * v[0] + v[2] * v[2]);
+        if (boundaries[b] == BK_BOUNDARY_PERIODIC)
+            expected += etac * (v[0] - v[2]) * (v[0] - v[2]);
+        assert_close(power, expected, 1e-14, 0);
+        assert_close(bk_model_damping_force(m, 1, v), -1.0 * v[1] + etac * (v[0] - v[1]) + etac * (v[2] - v[1]),
+                     1e-15, 0);
+        bk_model_free(m);
+    }
+    /* Coupling dashpots on a lone block exist only with walls to pull on. */
+    bk_model *one = make_chain(1, BK_BOUNDARY_FREE, BK_SPRING_LINEAR);
+    one->coupling_damping = etac;
+    assert_false(bk_model_is_damped(one));
+    one->boundary = BK_BOUNDARY_FIXED;
+    assert_true(bk_model_is_damped(one));
+    assert_close(bk_model_damping_force(one, 0, v), -2.0 * etac * v[0], 1e-15, 0);
+    one->boundary = BK_BOUNDARY_FREE;
+    one->blocks[0].damping = 7.5;
+    assert_true(bk_model_is_damped(one));
+    assert_close(bk_model_damping_force(one, 0, v), -7.5 * v[0], 1e-15, 0);
+    bk_model_free(one);
+}
+
 static void test_tension_only(void **state)
 {
     (void)state;
@@ -148,6 +192,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_forces_free),
         cmocka_unit_test(test_forces_fixed_and_periodic),
+        cmocka_unit_test(test_damping),
         cmocka_unit_test(test_tension_only),
         cmocka_unit_test(test_energy_gradient),
         cmocka_unit_test(test_kinetic_energy),

@@ -31,6 +31,7 @@ struct bk_checkpoint {
     long *instant_count;       /* chattering guard */
     long next_sample;          /* index of the next sample time */
     double work_driver, dissipation;         /* J, since t = 0 */
+    double damping_dissipation;              /* J, since t = 0 */
     double elastic_initial, kinetic_initial; /* J, at t = 0 (for the energy residual) */
     double t_last_row;         /* s */
     long steps_since_row;
@@ -66,6 +67,8 @@ typedef struct bk_checkpoint_field {
     bk_checkpoint_type type;
     bk_checkpoint_extent extent;
     size_t offset;    /* offsetof(bk_checkpoint or bk_catalog_state, member) */
+    int if_nonzero;   /* a scalar added after the format: written and hashed only when non-zero,
+                         read as 0 where absent, so earlier files verify as they did */
 } bk_checkpoint_field;
 
 /* In the order written and hashed (part of the file format: files written by earlier
@@ -78,6 +81,8 @@ extern const size_t bk_checkpoint_n_fields;
 size_t bk_checkpoint_type_size(bk_checkpoint_type type);
 /* Whether this checkpoint has the field (a catalog field only with a catalog). */
 int bk_checkpoint_field_present(const bk_checkpoint_field *field, const bk_checkpoint *cp);
+/* Whether a slot holds the field: present, and non-zero if it is an if_nonzero one. */
+int bk_checkpoint_field_stored(const bk_checkpoint_field *field, const bk_checkpoint *cp);
 /* Values the field holds in this checkpoint: 1, n_blocks or n_state (0 when absent). */
 size_t bk_checkpoint_field_count(const bk_checkpoint_field *field, const bk_checkpoint *cp);
 /* Where the values are: the array for array fields, the member itself for scalars.  NULL when
@@ -92,10 +97,13 @@ typedef struct bk_stat_field {
     int is_long;      /* long, else double */
     size_t offset;    /* offsetof(bk_run_stats, member) */
     const char *units;
+    int if_nonzero;   /* as bk_checkpoint_field's */
 } bk_stat_field;
 
 extern const bk_stat_field bk_run_stats_fields[];
 extern const size_t bk_run_stats_n_fields;
+/* The counter is zero (what decides whether an if_nonzero one is written and hashed). */
+int bk_stat_is_zero(const bk_run_stats *stats, const bk_stat_field *field);
 
 /* ---- integrity ---- */
 

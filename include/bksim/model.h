@@ -1,9 +1,11 @@
 /* The Burridge-Knopoff chain: N blocks on a rigid surface, neighbours joined by coupling
  * springs, each block pulled by its own driver spring.
  *
- *   m_i x_i'' = F_i(x, D(t)) - s_i f_i
+ *   m_i x_i'' = F_i(x, D(t)) + G_i(v) - s_i f_i
  *   F_i = k_i (D - x_i)          driver spring (tension_only: k_i max(0, D - x_i))
  *       + kc (x_{i+1} - x_i) + kc (x_{i-1} - x_i)   coupling, per the boundary
+ *   G_i = -eta_i v_i             dashpot to the substrate (radiation damping)
+ *       + etac (v_{i+1} - v_i) + etac (v_{i-1} - v_i)   dashpots beside the coupling springs
  *
  * x_i is the displacement from the relaxed reference configuration (m), D the driver
  * displacement, f_i the friction force magnitude, s_i the slip direction.  Boundaries:
@@ -35,6 +37,7 @@ typedef struct bk_block {
     double normal_force;     /* N, > 0; default mass * gravity */
     double x_init;           /* m, initial displacement; default 0 */
     double v_init;           /* m/s, initial velocity; default 0 */
+    double damping;          /* N s/m, >= 0: dashpot to the substrate, force -damping * v */
     const bk_friction_law *law;
     double friction_params[BK_FRICTION_MAX_PARAMS]; /* in law->params order */
     size_t state_offset;     /* first friction state of this block in the model's state array */
@@ -44,6 +47,7 @@ typedef struct bk_model {
     size_t n_blocks;
     bk_boundary boundary;
     double coupling_stiffness; /* N/m, >= 0 */
+    double coupling_damping;   /* N s/m, >= 0: dashpot in parallel with every coupling spring */
     double gravity;            /* m/s^2, used for default normal forces */
     bk_spring spring;
     bk_driver driver;
@@ -61,8 +65,13 @@ void bk_model_finalize(bk_model *model);
 double bk_model_driver_force(const bk_model *model, size_t i, double x_i, double driver_pos);
 /* Coupling-spring force on block i for positions x (N). */
 double bk_model_coupling_force(const bk_model *model, size_t i, const double *x);
-/* Applied (non-friction) force on block i: driver + coupling (N). */
+/* Spring force on block i: driver + coupling (N); bk_model_damping_force adds the dashpots. */
 double bk_model_applied_force(const bk_model *model, size_t i, const double *x, double driver_pos);
+/* Dashpot force on block i for velocities v (N): its own damping and the coupling dashpots
+ * (a fixed wall stands still). */
+double bk_model_damping_force(const bk_model *model, size_t i, const double *v);
+/* Some block has damping or the coupling springs have dashpots: the motion depends on v. */
+int bk_model_is_damped(const bk_model *model);
 /* Elastic energy stored in all springs (J). */
 double bk_model_elastic_energy(const bk_model *model, const double *x, double driver_pos);
 /* Kinetic energy (J). */

@@ -27,6 +27,7 @@ typedef struct bk_sample {
     double elastic_energy;    /* J */
     double work_driver;       /* J, work done by the driver since t = 0 */
     double dissipation;       /* J, frictional dissipation since t = 0 */
+    double damping_dissipation; /* J, dissipated by the dashpots since t = 0 (0 without) */
     int is_event;             /* bk_row_kind */
 } bk_sample;
 
@@ -47,7 +48,7 @@ typedef struct bk_transition {
     int8_t to;     /* bk_mode */
     double x;      /* m, position at the transition */
     double v;      /* m/s, velocity after it (0 when it sticks or starts from rest) */
-    double force;  /* N, applied (spring) force on the block at the transition */
+    double force;  /* N, applied force (springs and dashpots) on the block at the transition */
 } bk_transition;
 
 /* A checkpoint (bksim/checkpoint.h): the state a run continues from. */
@@ -81,10 +82,11 @@ typedef struct bk_run_stats {
     double wall_time;         /* s */
     double cpu_time;          /* s */
     double work_driver;       /* J */
-    double dissipation;       /* J */
+    double dissipation;       /* J, by friction */
+    double damping_dissipation; /* J, by the dashpots */
     double elastic_change;    /* J, elastic energy at t_reached minus at 0 */
     double kinetic_change;    /* J */
-    double energy_residual;   /* (W - dE_el - dE_kin - D) / max(|W|, tiny), dimensionless */
+    double energy_residual;   /* (W - dE_el - dE_kin - D - D_damping) / the largest term, dimensionless */
 } bk_run_stats;
 
 /* What a progress callback is told: how far the run is, and what it has produced. */

@@ -170,7 +170,7 @@ int bk_h5_sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
     if (group < 0)
         ok = -1;
     for (size_t k = 0; ok >= 0 && k < bk_checkpoint_n_fields; ++k)
-        if (bk_checkpoint_field_present(&bk_checkpoint_fields[k], cp))
+        if (bk_checkpoint_field_stored(&bk_checkpoint_fields[k], cp))
             ok = put_field(group, &bk_checkpoint_fields[k], cp);
     /* Whether the slot holds a catalog: read before its fields, as the counts are. */
     if (ok >= 0)
@@ -215,6 +215,8 @@ static herr_t read_stats(hid_t group, bk_run_stats *stats)
     herr_t rc = 0;
     for (size_t i = 0; rc >= 0 && i < bk_run_stats_n_fields; ++i) {
         char *field = (char *)stats + bk_run_stats_fields[i].offset;
+        if (bk_run_stats_fields[i].if_nonzero && H5Aexists(g, bk_run_stats_fields[i].name) <= 0)
+            continue; /* written only when non-zero (stats arrive zeroed) */
         if (bk_run_stats_fields[i].is_long) {
             long long value = 0;
             rc = bk_h5_read_numeric_attr(g, bk_run_stats_fields[i].name, H5T_NATIVE_LLONG, &value);
@@ -377,9 +379,12 @@ static int read_slot(hid_t file, hid_t top, const char *name, size_t n_blocks,
         return BK_ERR_NOMEM;
     }
     herr_t ok = has_catalog == 0 || has_catalog == 1 ? 0 : -1;
-    for (size_t k = 0; ok >= 0 && k < bk_checkpoint_n_fields; ++k)
-        if (bk_checkpoint_field_present(&bk_checkpoint_fields[k], cp))
-            ok = get_field(group, &bk_checkpoint_fields[k], cp);
+    for (size_t k = 0; ok >= 0 && k < bk_checkpoint_n_fields; ++k) {
+        const bk_checkpoint_field *f = &bk_checkpoint_fields[k];
+        int present = f->if_nonzero ? H5Aexists(group, f->name) > 0 : bk_checkpoint_field_present(f, cp);
+        if (present)
+            ok = get_field(group, f, cp);
+    }
     uint64_t stored = 0;
     if (ok >= 0)
         ok = bk_h5_read_numeric_attr(group, "rows", H5T_NATIVE_LLONG, &rec->rows);

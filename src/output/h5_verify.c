@@ -239,7 +239,8 @@ static char *expected_datasets(hid_t file)
     char list[BK_DATASET_LIST_LEN] = "time,driver,event";
     if (bk_h5_load_stored_config(file, "", &config, &ignored) == BK_OK)
         bk_output_dataset_names(config->output.fields, config->model->n_friction_state,
-                     config->output.transitions, config->output.events, list, sizeof list);
+                                bk_model_is_damped(config->model), config->output.transitions,
+                                config->output.events, list, sizeof list);
     bk_config_free(config);
     return strdup(list);
 }

@@ -164,7 +164,7 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
         stored = bk_h5_write_string_attr(w->file, "overrides", overrides);
     free(overrides);
     char names[BK_DATASET_LIST_LEN];
-    bk_output_dataset_names(fields, n_state, config->output.transitions, config->output.events, names,
+    bk_output_dataset_names(fields, n_state, bk_model_is_damped(model), config->output.transitions, config->output.events, names,
                             sizeof names);
     if (stored >= 0)
         stored = bk_h5_write_string_attr(w->file, "datasets", names);
@@ -175,7 +175,7 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
     for (int i = 0; i < BK_N_SERIES; ++i) {
         const bk_series_def *def = &bk_series[i];
         bk_h5_series *s = &w->s[i];
-        if (!bk_series_selected(def, fields, n_state))
+        if (!bk_series_selected(def, fields, n_state, bk_model_is_damped(model)))
             continue;
         if (bk_h5_writer_series(w, i, model) < 0)
             return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for the /%s buffer", w->part,
@@ -539,6 +539,7 @@ static int sink_sample(void *self, const bk_sample *sample, bk_error *err)
     put_double(&s[BK_SERIES_EEL], sample->elastic_energy);
     put_double(&s[BK_SERIES_WORK], sample->work_driver);
     put_double(&s[BK_SERIES_DISS], sample->dissipation);
+    put_double(&s[BK_SERIES_DAMP], sample->damping_dissipation);
     for (size_t k = 0; k < sizeof rows / sizeof *rows; ++k)
         put_row(&s[row_series[k]], rows[k]);
     int rc = BK_OK;
@@ -622,6 +623,8 @@ herr_t bk_h5_write_stats(hid_t file, const bk_run_stats *stats)
     for (size_t i = 0; i < bk_run_stats_n_fields; ++i) {
         const char *field = (const char *)stats + bk_run_stats_fields[i].offset;
         herr_t ok;
+        if (bk_run_stats_fields[i].if_nonzero && bk_stat_is_zero(stats, &bk_run_stats_fields[i]))
+            continue;
         if (bk_run_stats_fields[i].is_long) {
             long value;
             memcpy(&value, field, sizeof value);

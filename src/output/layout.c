@@ -30,6 +30,9 @@ const bk_series_def bk_series[BK_N_SERIES] = {
                         "work done by the driver since t = 0"},
     [BK_SERIES_DISS] = {"dissipation", BK_FIELD_ENERGY, BK_SHAPE_T, BK_KIND_F64, "J",
                         "frictional dissipation since t = 0"},
+    [BK_SERIES_DAMP] = {"damping_dissipation", BK_FIELD_ENERGY, BK_SHAPE_T, BK_KIND_F64, "J",
+                        "energy dissipated by the dashpots ([block] damping, [model] coupling_damping) "
+                        "since t = 0", 1},
     [BK_SERIES_STATE] = {"friction_state", BK_FIELD_STATE, BK_SHAPE_TS, BK_KIND_F64,
                          "law-specific",
                          "friction-law state variables; attribute 'block' gives each column's "
@@ -44,9 +47,9 @@ _Static_assert(sizeof bk_output_field_names / sizeof bk_output_field_names[0] - 
                    BK_FIELD_ALL == (1u << 7) - 1,
                "bk_output_field_names must name every BK_FIELD_* bit in order");
 
-int bk_series_selected(const bk_series_def *def, unsigned fields, size_t n_state)
+int bk_series_selected(const bk_series_def *def, unsigned fields, size_t n_state, int damped)
 {
-    if (def->field && !(fields & def->field))
+    if ((def->field && !(fields & def->field)) || (def->damped_only && !damped))
         return 0;
     return def->shape != BK_SHAPE_TS || n_state > 0;
 }
@@ -69,23 +72,23 @@ size_t bk_series_value_size(bk_series_kind kind)
     return kind == BK_KIND_F64 ? sizeof(double) : 1;
 }
 
-double bk_output_row_bytes(unsigned fields, size_t n_blocks, size_t n_state)
+double bk_output_row_bytes(unsigned fields, size_t n_blocks, size_t n_state, int damped)
 {
     double bytes = 0.0;
     for (int i = 0; i < BK_N_SERIES; ++i)
-        if (bk_series_selected(&bk_series[i], fields, n_state))
+        if (bk_series_selected(&bk_series[i], fields, n_state, damped))
             bytes += (double)bk_series_columns(&bk_series[i], n_blocks, n_state) *
                      (double)bk_series_value_size(bk_series[i].kind);
     return bytes;
 }
 
-void bk_output_dataset_names(unsigned fields, size_t n_state, int transitions, int events,
+void bk_output_dataset_names(unsigned fields, size_t n_state, int damped, int transitions, int events,
                              char *buf, size_t len)
 {
     size_t used = 0;
     buf[0] = '\0';
     for (int i = 0; i < BK_N_SERIES; ++i)
-        if (bk_series_selected(&bk_series[i], fields, n_state)) {
+        if (bk_series_selected(&bk_series[i], fields, n_state, damped)) {
             int n = snprintf(buf + used, len - used, "%s%s", used ? "," : "", bk_series[i].name);
             if (n > 0 && (size_t)n < len - used)
                 used += (size_t)n;

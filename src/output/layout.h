@@ -20,13 +20,14 @@ typedef struct bk_series_def {
     bk_series_kind kind;
     const char *units;
     const char *description;
+    int damped_only;         /* written only when the model has dashpots (bk_model_is_damped) */
 } bk_series_def;
 
 /* Indices into bk_series, in the order the datasets are created. */
 enum {
     BK_SERIES_TIME, BK_SERIES_DRIVER, BK_SERIES_EVENT, BK_SERIES_X, BK_SERIES_V,
     BK_SERIES_FRICTION, BK_SERIES_COF, BK_SERIES_MODE, BK_SERIES_EKIN, BK_SERIES_EEL,
-    BK_SERIES_WORK, BK_SERIES_DISS, BK_SERIES_STATE, BK_N_SERIES
+    BK_SERIES_WORK, BK_SERIES_DISS, BK_SERIES_DAMP, BK_SERIES_STATE, BK_N_SERIES
 };
 
 extern const bk_series_def bk_series[BK_N_SERIES];
@@ -40,7 +41,7 @@ extern const char *const bk_output_field_names[];
 #define BK_TRANSITIONS_UNITS "t: s, block: 1, from: 1, to: 1, x: m, v: m/s, force: N"
 #define BK_TRANSITIONS_DESCRIPTION                                                         \
     "mode transitions: time, block (0-based), from/to mode (stick 0, slip+ 1, slip- -1), " \
-    "position, velocity after the transition, applied spring force"
+    "position, velocity after the transition, applied force (springs and dashpots)"
 
 /* Bytes of one /events record on disk (packed: t_start, t_end, first_block, n_blocks, left,
  * right, n_episodes, potency, magnitude, max_slip_rate, stress_drop, complete). */
@@ -57,9 +58,10 @@ extern const char *const bk_output_field_names[];
     "magnitude_offset; stress_drop: mean drop of the applied force over the blocks; "          \
     "complete: 0 for an event still running at the end of the run"
 
-/* Whether a run with these output fields and friction states writes this series: the one
- * rule behind the layout, the list of datasets a reader must find and the size estimate. */
-int bk_series_selected(const bk_series_def *def, unsigned fields, size_t n_state);
+/* Whether a run with these output fields and friction states, and dashpots or not (damped),
+ * writes this series: the one rule behind the layout, the list of datasets a reader must find
+ * and the size estimate. */
+int bk_series_selected(const bk_series_def *def, unsigned fields, size_t n_state, int damped);
 
 /* Values per row of a series in a chain of n_blocks blocks and n_state friction states. */
 size_t bk_series_columns(const bk_series_def *def, size_t n_blocks, size_t n_state);
@@ -68,12 +70,12 @@ size_t bk_series_columns(const bk_series_def *def, size_t n_blocks, size_t n_sta
 size_t bk_series_value_size(bk_series_kind kind);
 
 /* Bytes one time-series row takes on disk (chunk overhead aside). */
-double bk_output_row_bytes(unsigned fields, size_t n_blocks, size_t n_state);
+double bk_output_row_bytes(unsigned fields, size_t n_blocks, size_t n_state, int damped);
 
 /* The datasets a run of this layout writes, comma-separated (recorded in the root attribute
  * "datasets" so that a check needs no config to know what must be there). */
 #define BK_DATASET_LIST_LEN 256
-void bk_output_dataset_names(unsigned fields, size_t n_state, int transitions, int events,
+void bk_output_dataset_names(unsigned fields, size_t n_state, int damped, int transitions, int events,
                              char *buf, size_t len);
 
 #endif

@@ -275,7 +275,7 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     if (!problem->affine)
         return BK_FAIL(err, BK_ERR_CONFIG,
                        "method exact needs Coulomb friction (constant sliding force, no friction "
-                       "state)" USE_INTEGRATOR);
+                       "state) and no dashpots (no damping)" USE_INTEGRATOR);
     size_t p = problem->n_pairs;
     if (2 * p > n || (p > 0 && !problem->pair_mass))
         return BK_FAIL(err, BK_ERR_CONFIG,

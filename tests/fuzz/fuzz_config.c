@@ -38,14 +38,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (!m || m->n_blocks == 0 || !(c->t_end > 0.0) || !isfinite(c->t_end) || !c->output.path ||
             !(c->solver.rtol > 0.0) ||
             (strcmp(c->solver.method, "auto") != 0 && !bk_solver_backend_find(c->solver.method)) ||
-            !isfinite(m->driver.velocity) || !isfinite(m->driver.start_position))
+            !isfinite(m->driver.velocity) || !isfinite(m->driver.start_position) ||
+            !(m->coupling_damping >= 0.0) || !isfinite(m->coupling_damping))
             abort();
         /* Every value finite and in range, derived ones (normal_force = mass * gravity) too. */
         for (size_t i = 0; i < m->n_blocks; ++i) {
             const bk_block *b = &m->blocks[i];
             if (!b->law || !(b->mass > 0.0) || !isfinite(b->mass) || !(b->normal_force > 0.0) ||
                 !isfinite(b->normal_force) || !isfinite(b->driver_stiffness) || !isfinite(b->x_init) ||
-                !isfinite(b->v_init))
+                !isfinite(b->v_init) || !(b->damping >= 0.0) || !isfinite(b->damping))
                 abort();
             for (size_t p = 0; p < b->law->n_params; ++p)
                 if (!isfinite(b->friction_params[p]))

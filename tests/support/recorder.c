@@ -25,7 +25,7 @@ int record_sample(void *self, const bk_sample *s, bk_error *err)
         if (!isfinite(s->x[i]) || !isfinite(s->v[i]) || !isfinite(s->friction[i]))
             r->non_finite = 1;
     double balance = s->work_driver - (s->elastic_energy - r->elastic0) -
-                     (s->kinetic_energy - r->kinetic0) - s->dissipation;
+                     (s->kinetic_energy - r->kinetic0) - s->dissipation - s->damping_dissipation;
     r->max_balance_error = fmax(r->max_balance_error, fabs(balance));
     r->max_work = fmax(r->max_work, fabs(s->work_driver));
     if (r->exact) {

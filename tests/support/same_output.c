@@ -6,18 +6,18 @@
 
 #include "bk_test.h"
 #include "bksim/bksim.h"
+#include "output/layout.h"
 
 void assert_same_output(const char *a, const char *b)
 {
-    static const char *const names[] = {"time", "driver", "event", "x", "v", "friction", "cof", "mode",
-                                        "energy_kinetic", "energy_elastic", "work_driver", "dissipation",
-                                        "friction_state"};
+    /* Every series of the layout table, so a dataset added there is compared too. */
     bk_error err = {0};
-    for (size_t k = 0; k < sizeof names / sizeof names[0]; ++k) {
+    for (int k = 0; k < BK_N_SERIES; ++k) {
+        const char *const name = bk_series[k].name;
         double *da = NULL, *db = NULL;
         size_t ra, ca, rb, cb;
-        int in_a = bk_h5_read_doubles(a, names[k], &da, &ra, &ca, &err) == BK_OK;
-        int in_b = bk_h5_read_doubles(b, names[k], &db, &rb, &cb, &err) == BK_OK;
+        int in_a = bk_h5_read_doubles(a, name, &da, &ra, &ca, &err) == BK_OK;
+        int in_b = bk_h5_read_doubles(b, name, &db, &rb, &cb, &err) == BK_OK;
         assert_int_equal(in_a, in_b);
         if (in_a) {
             assert_int_equal(ra, rb);
