@@ -193,6 +193,54 @@ static void check_initial_energy(loader *ld, const bk_model *m)
     free(x);
 }
 
+/* The driver: a constant velocity, or a history of velocities and durations.  Returns the
+ * history's length (s), or NAN for a constant velocity (or an error, reported). */
+static double build_driver(loader *ld, bk_model *m)
+{
+    m->driver.start_position = value_of(ld, "driver", "start_position");
+    entry *velocity = bk_config_lookup(ld, "driver", "velocity");
+    entry *velocities = bk_config_lookup(ld, "driver", "velocities");
+    entry *durations = bk_config_lookup(ld, "driver", "durations");
+    if (velocity && velocities) {
+        bk_config_report_entry(ld, velocities, "give velocity (constant) or velocities (a history), not both "
+                               "(velocity is set at %s)", velocity->value);
+        return NAN;
+    }
+    if (!velocities) {
+        if (durations)
+            bk_config_report_entry(ld, durations, "applies with [driver] velocities, which is not given");
+        else if (!velocity)
+            report_missing(ld, "driver", &bk_config_find_key("driver", "velocity")->param,
+                           bk_config_find_key("driver", "velocity"));
+        m->driver.velocity = velocity ? velocity->number : NAN;
+        return NAN;
+    }
+    if (!durations) {
+        bk_config_report_entry(ld, velocities, "needs [driver] durations, one per velocity");
+        return NAN;
+    }
+    size_t n = (size_t)velocities->number;
+    if ((size_t)durations->number != n) {
+        bk_config_report_entry(ld, durations, "has %zu values, velocities has %zu (allowed: one duration per "
+                               "velocity)", (size_t)durations->number, n);
+        return NAN;
+    }
+    double total = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+        total += durations->list[k];
+        if (!isfinite(total)) {
+            bk_config_report_entry(ld, durations, "segment %zu makes the history longer than any finite time "
+                                   "(allowed: a finite total duration)", k + 1);
+            return NAN;
+        }
+    }
+    if (bk_driver_set_history(&m->driver, velocities->list, durations->list, n) != 0) {
+        bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+        return NAN;
+    }
+    return total;
+}
+
 /* The chain: model, blocks, friction, driver. */
 static void build_chain(loader *ld, bk_config *c)
 {
@@ -211,8 +259,7 @@ static void build_chain(loader *ld, bk_config *c)
     m->coupling_damping = value_of(ld, "model", "coupling_damping");
     m->gravity = value_of(ld, "model", "gravity");
     m->spring = (bk_spring)(int)value_of(ld, "driver", "spring");
-    m->driver.velocity = value_of(ld, "driver", "velocity");
-    m->driver.start_position = value_of(ld, "driver", "start_position");
+    double history = build_driver(ld, m);
 
     static const char *const required[] = {"mass", "driver_stiffness"};
     if (bk_config_plan_parameters(ld, n) != 0)
@@ -256,7 +303,16 @@ static void build_chain(loader *ld, bk_config *c)
     gsl_rng_free(rng);
     bk_model_finalize(m);
     check_initial_energy(ld, m);
-    c->t_end = value_of(ld, "run", "t_end");
+    entry *t_end = bk_config_lookup(ld, "run", "t_end");
+    if (isnan(history) || !m->driver.n_segments) {
+        c->t_end = value_of(ld, "run", "t_end");
+    } else {
+        /* The history is the run's schedule: t_end defaults to its length, and may not pass it. */
+        c->t_end = t_end ? t_end->number : history;
+        if (t_end && t_end->number > history * (1 + 1e-12))
+            bk_config_report_entry(ld, t_end, "must be <= the driver history's length (%.10g s), got %s", history,
+                                   t_end->value);
+    }
 }
 
 /* A prescribed-motion scene: the schedule and one block's friction.  The chain's keys are

@@ -72,8 +72,16 @@ static const key_def keys[] = {
     {"friction", {"law", "", NAN, 0, 0, BK_PARAM_REQUIRED, "friction law; its parameters follow in the same section"},
      BK_KEY_CHOICE, NULL, law_name, NULL},
 
-    NUM("driver", "velocity", "m/s", NAN, -INFINITY, INFINITY,
-        BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE, "driver velocity (constant)"),
+    {"driver", {"velocity", "m/s", NAN, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
+                "driver velocity (constant); give it or velocities"}, BK_KEY_NUMBER, NULL, NULL, "required, or velocities"},
+    {"driver", {"velocities", "m/s", NAN, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
+                  "a history instead of velocity: the velocity of each segment in order (0: a hold); velocity "
+                  "steps and slide-hold-slide on any chain, every breakpoint a restart"},
+     BK_KEY_LIST, NULL, NULL, "-"},
+    {"driver", {"durations", "s", NAN, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
+                 "with velocities: the duration of each segment, as many as velocities; [run] t_end defaults to "
+                 "their sum and may not exceed it"},
+     BK_KEY_LIST, NULL, NULL, "-"},
     {"driver", {"spring", "", 0, 0, 0, 0, "driver springs: linear, or tension_only (pull, never push; NOTES.md 3)"},
      BK_KEY_CHOICE, spring_names, NULL, "linear"},
     NUM("driver", "start_position", "m", 0.0, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
@@ -154,7 +162,8 @@ static const key_def keys[] = {
      BK_KEY_NUMBER, NULL, NULL, "none"},
 
     NUM("run", "t_end", "s", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE,
-        "end time (runs from 0); in a prescribed scene optional, at most the schedule's length"),
+        "end time (runs from 0); with a prescribed schedule or [driver] velocities optional, at most the "
+        "schedule's length"),
     NUM("run", "wall_time_limit", "s", 0.0, 0.0, INFINITY, 0,
         "wall-clock time after which the run stops with an error, keeping what it wrote (0: no limit)"),
 

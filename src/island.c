@@ -151,6 +151,7 @@ void bk_island_restart(bk_island *island, double t, double *y)
     island->n_active = 0;
     island->n_stateful = 0;
     island->affine = scene->affine && !scene->full_layout;
+    island->driver_segment = bk_driver_segment(&model->driver, t);
     double driver_pos = bk_driver_position(&model->driver, t);
     for (size_t k = 0; k < island->len; ++k) {
         size_t i = bk_island_block(island, k);
@@ -282,7 +283,7 @@ static void rhs_parts(const bk_island *island, double t, const double *y, double
 {
     const bk_scene *scene = island->scene;
     const bk_model *model = scene->model;
-    double driver_pos = bk_driver_position(&model->driver, t);
+    double driver_pos = bk_driver_segment_position(&model->driver, island->driver_segment, t);
     double driver_force_sum = 0.0;
     double dissipation_rate = 0.0, damping_rate = 0.0;
     double *state_rates = f_implicit ? f_implicit : ydot;
@@ -332,7 +333,7 @@ static void rhs_parts(const bk_island *island, double t, const double *y, double
                 ydot[scene->state_slot[i] + j] = 0.0;
     }
     double *energy_rates = &ydot[island->n_y - scene->n_energy];
-    energy_rates[0] = bk_driver_velocity(&model->driver, t) * driver_force_sum;
+    energy_rates[0] = bk_driver_segment_velocity(&model->driver, island->driver_segment) * driver_force_sum;
     energy_rates[1] = dissipation_rate;
     if (scene->damped)
         energy_rates[2] = damping_rate;
@@ -395,13 +396,13 @@ static void damping_jacobian(const bk_island *island, const double *y, size_t i,
 
 /* The Jacobian of the whole right-hand side, or (friction_only) of its friction and dashpot
  * part. */
-static void jacobian_parts(const bk_island *island, double t, const double *y, int friction_only,
+static void jacobian_parts(const bk_island *island, const double *y, int friction_only,
                            void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
 {
     const bk_scene *scene = island->scene;
     const bk_model *model = scene->model;
     double kc = model->coupling_stiffness;
-    double speed = bk_driver_velocity(&model->driver, t);
+    double speed = bk_driver_segment_velocity(&model->driver, island->driver_segment);
     size_t work_row = island->n_y - scene->n_energy, dissipation_row = work_row + 1;
     for (size_t k = 0; k < island->n_active; ++k) {
         size_t i = island->active[k], s = scene->slot[i];
@@ -473,14 +474,16 @@ static void jacobian_parts(const bk_island *island, double t, const double *y, i
 int bk_island_jacobian(double t, const double *y, void *user,
                        void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
 {
-    jacobian_parts(user, t, y, 0, put, matrix);
+    (void)t; /* the driver's segment is the island's: nothing here depends on the time */
+    jacobian_parts(user, y, 0, put, matrix);
     return 0;
 }
 
 int bk_island_jacobian_implicit(double t, const double *y, void *user,
                                 void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
 {
-    jacobian_parts(user, t, y, 1, put, matrix);
+    (void)t;
+    jacobian_parts(user, y, 1, put, matrix);
     return 0;
 }
 
@@ -490,7 +493,7 @@ int bk_island_roots(double t, const double *y, double *g, void *user)
     const bk_scene *scene = island->scene;
     const bk_model *model = scene->model;
     size_t R = scene->roots_per_block;
-    double driver_pos = bk_driver_position(&model->driver, t);
+    double driver_pos = bk_driver_segment_position(&model->driver, island->driver_segment, t);
     for (size_t k = 0; k < island->len; ++k) {
         size_t i = bk_island_block(island, k);
         const bk_block *b = &model->blocks[i];
@@ -531,7 +534,7 @@ double bk_island_slip_acceleration(const bk_island *island, size_t i, double t, 
     const bk_scene *scene = island->scene;
     const bk_block *b = &scene->model->blocks[i];
     size_t s = scene->slot[i];
-    double driver_pos = bk_driver_position(&scene->model->driver, t);
+    double driver_pos = bk_driver_segment_position(&scene->model->driver, island->driver_segment, t);
     double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
     double dir = (double)scene->mode[i];
     double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) +

@@ -65,7 +65,7 @@ double bk_stiffness_ratio(const bk_model *model)
     size_t *velocity_row_block = malloc(n_max * sizeof *velocity_row_block);
     double ratio = NAN;
     if (y && diagonal && omega2 && velocity_row_block && bk_island_reserve(&island, n) == 0) {
-        double speed = fabs(bk_driver_velocity(&model->driver, 0.0));
+        double speed = fabs(model->driver.velocity); /* a history's first non-zero speed */
         for (size_t i = 0; i < n; ++i) {
             probe.mode[i] = BK_MODE_SLIP_POS;
             probe.v[i] = speed;

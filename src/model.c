@@ -25,6 +25,7 @@ void bk_model_free(bk_model *model)
     if (!model)
         return;
     free(model->blocks);
+    bk_driver_free_history(&model->driver);
     free(model);
 }
 

@@ -85,8 +85,8 @@ static void plan_restart(run_ctx *ctx)
 
 double bk_run_stop_time(const run_ctx *ctx)
 {
-    double t_checkpoint = bk_run_checkpoint_time(ctx);
-    return t_checkpoint < ctx->t_end ? t_checkpoint : ctx->t_end;
+    double t_stop = fmin(bk_run_checkpoint_time(ctx), ctx->t_breakpoint);
+    return t_stop < ctx->t_end ? t_stop : ctx->t_end;
 }
 
 double bk_run_zero_after(run_ctx *ctx, gsl_function *f, double lo, double hi)
@@ -201,7 +201,17 @@ static int schedule(run_ctx *ctx)
             break;
         case STOP:
             if (t_stop < ctx->t_end) {
-                rc = bk_run_checkpoint(ctx, t_stop);
+                /* A driver breakpoint restarts everything on the next segment's line (its
+                 * quiet blocks' failure times too, so the next breakpoint is set first). */
+                int breakpoint = t_stop == ctx->t_breakpoint;
+                if (breakpoint)
+                    ctx->t_breakpoint = bk_driver_next_breakpoint(&ctx->model->driver, t_stop);
+                if (t_stop == bk_run_checkpoint_time(ctx))
+                    rc = bk_run_checkpoint(ctx, t_stop);
+                else if ((rc = bk_run_unpack_all(ctx, t_stop)) == BK_OK) {
+                    bk_run_rebase_energy(ctx, t_stop);
+                    rc = bk_run_partition_all(ctx, t_stop);
+                }
                 break;
             }
             if ((rc = bk_run_unpack_all(ctx, ctx->t_end)) != BK_OK)
@@ -344,6 +354,7 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
     ctx.wall_checkpoint = wall0;
     ctx.checkpoint_work = config->output.checkpoint_work;
     ctx.t_restart = INFINITY;
+    ctx.t_breakpoint = bk_driver_next_breakpoint(&config->model->driver, from ? from->t : 0.0);
     ctx.t_row_due = NAN;
     ctx.max_bytes = config->output.max_bytes > 0.0 ? config->output.max_bytes : INFINITY;
     ctx.row_bytes = bk_output_row_bytes(config->output.fields, config->model->n_blocks,

@@ -119,6 +119,7 @@ typedef struct run_ctx {
     double checkpoint_work;          /* 0: restart points by the interval, or none */
     double restart_work;             /* block-steps, transitions and row blocks since the last */
     double t_restart;                /* s, the next automatic restart point; +inf: not yet due */
+    double t_breakpoint;             /* s, the driver history's next breakpoint, a restart; +inf: none */
     double t_settled;                /* s, the time of the scheduler's last action */
     double checkpoint_wall_interval; /* s: write a restart point once this has passed */
     double wall_checkpoint;          /* s, monotonic clock at the last one written (or the start) */

@@ -722,12 +722,14 @@ int bk_run_quiet_failures(run_ctx *ctx, double t)
     qsort(ctx->batch, count, sizeof *ctx->batch, by_block);
     double driver_pos = bk_driver_position(&model->driver, t);
     /* The force crosses the threshold the way the driver pulls; passing that direction
-     * instead of the force itself is immune to rounding at the threshold. */
-    double pull = bk_driver_velocity(&model->driver, t) > 0.0 ? 1.0 : -1.0;
+     * instead of the force itself is immune to rounding at the threshold.  A resting driver
+     * (a hold) pulls nowhere: a threshold aging below the force gives way to the force. */
+    double speed = bk_driver_velocity(&model->driver, t);
     for (size_t k = 0; k < count; ++k) {
         size_t i = ctx->batch[k];
         bk_scene_age(scene, i, t);
         double force = bk_scene_applied_force(scene, i, driver_pos);
+        double pull = speed > 0.0 ? 1.0 : speed < 0.0 ? -1.0 : force >= 0.0 ? 1.0 : -1.0;
         bk_mode from = (bk_mode)scene->mode[i];
         bk_mode to = bk_mode_next(from, BK_EVENT_BREAKAWAY, pull, 0.0);
         bk_run_leave_stuck(ctx, i, t);

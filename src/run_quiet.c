@@ -37,7 +37,9 @@ static double coulomb_failure(const run_ctx *ctx, size_t i, double t, double thr
     double here = bk_driver_position(&model->driver, t);
     if ((target_position - here) * velocity <= 0.0)
         return t;
-    return bk_driver_time_at(&model->driver, t, target_position);
+    /* Within the driver's segment only: its breakpoint restarts everything and asks again. */
+    double t_fail = bk_driver_time_at(&model->driver, t, target_position);
+    return t_fail < ctx->t_breakpoint ? t_fail : INFINITY;
 }
 
 typedef struct aging_margin {
@@ -73,7 +75,7 @@ static double aging_failure(run_ctx *ctx, size_t i, double t)
     if (b->driver_stiffness == 0.0 || speed == 0.0)
         return INFINITY;
     double span = g0 / (b->driver_stiffness * speed);
-    double lo = t, hi = t, horizon = ctx->t_end;
+    double lo = t, hi = t, horizon = fmin(ctx->t_end, ctx->t_breakpoint);
     for (double ahead = AGING_SCAN_START * span;; ahead *= 2.0) {
         lo = hi;
         hi = t + ahead;

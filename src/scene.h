@@ -129,6 +129,8 @@ typedef struct bk_island {
     size_t n_active;         /* slipping blocks */
     size_t half_bandwidth;   /* Jacobian half bandwidth of the layout */
     double t_ref;            /* s, time of the last restart */
+    size_t driver_segment;   /* the driver's segment at the restart: its line is the driver until the
+                                next restart, which every breakpoint is */
     size_t *active;          /* the n_active slipping blocks, chain order from start */
     double *active_mass;     /* kg, their masses in the same order */
     size_t *stateful;        /* blocks whose law carries state */

@@ -241,6 +241,113 @@ static void test_damped_single_block(void **state)
     }
 }
 
+/* --- a driver history against the closed form, piece by piece -------------------------- */
+
+/* The paper's case A block under velocities V_j for durations d_j (linear spring).  In each
+ * segment the driver is a line, so a slipping block's deviation u = x - (D(t) - F_d / k)
+ * rings at w about it and the slip ends where V_j + u' first reaches zero; at a breakpoint
+ * x and v carry over and only the line changes; a stuck block breaks away where k (D - x)
+ * reaches F_s, or rests through the segment (a hold).  Transition times into out. */
+#define HISTORY_SEGMENTS 4
+static size_t history_closed_form(const double *velocities, const double *durations, double t_end,
+                                  double *out, size_t cap)
+{
+    const double m = 1.0, k = 1e4, f_s = 0.6 * 9.81, f_d = 0.1 * 9.81, w = sqrt(k / m);
+    double t = 0.0, x = 0.0, v = 0.0, seg_start = 0.0, d_start = 0.0;
+    int slipping = 0;
+    size_t n = 0;
+    for (size_t j = 0; j < HISTORY_SEGMENTS && t < t_end; ++j) {
+        double V = velocities[j], seg_end = fmin(seg_start + durations[j], t_end);
+        while (t < seg_end) {
+            double D = d_start + V * (t - seg_start);
+            if (!slipping) {
+                double t_break = V > 0.0 ? seg_start + (x + f_s / k - d_start) / V : INFINITY;
+                if (t_break >= seg_end) {
+                    t = seg_end;
+                    break;
+                }
+                t = fmax(t_break, t);
+                slipping = 1;
+                v = 0.0;
+                assert_true(n < cap);
+                out[n++] = t;
+                continue;
+            }
+            double u0 = x - D + f_d / k, du0 = v - V;
+            /* The first zero of V + u'(tau) = V - u0 w sin(w tau) + du0 cos(w tau) after t. */
+            double h = 1e-3 / w, lo = 0.0, hi = h, stop = INFINITY;
+            while (t + lo < seg_end) {
+                if (V - u0 * w * sin(w * hi) + du0 * cos(w * hi) <= 0.0) {
+                    for (int it = 0; it < 200; ++it) {
+                        double mid = 0.5 * (lo + hi);
+                        if (V - u0 * w * sin(w * mid) + du0 * cos(w * mid) > 0.0)
+                            lo = mid;
+                        else
+                            hi = mid;
+                    }
+                    stop = t + 0.5 * (lo + hi);
+                    break;
+                }
+                lo = hi;
+                hi += h;
+            }
+            double tau = (stop < seg_end ? stop : seg_end) - t;
+            x = d_start + V * (t + tau - seg_start) - f_d / k + u0 * cos(w * tau) + du0 / w * sin(w * tau);
+            v = V - u0 * w * sin(w * tau) + du0 * cos(w * tau);
+            t += tau;
+            if (stop < seg_end) {
+                slipping = 0;
+                v = 0.0;
+                assert_true(n < cap);
+                out[n++] = t;
+            }
+        }
+        d_start += V * durations[j];
+        seg_start += durations[j];
+    }
+    return n;
+}
+
+/* A velocity step inside the first slip, a hold, and a faster slide: every back-end's
+ * transitions at the closed-form times (the exact stepper restarts on each segment's line,
+ * to 1e-12 relative), nothing integrated through the hold, the driver row continuous. */
+static void test_driver_history(void **state)
+{
+    (void)state;
+    const double velocities[HISTORY_SEGMENTS] = {1e-3, 2e-3, 0.0, 3e-3};
+    const double durations[HISTORY_SEGMENTS] = {0.6, 0.6, 0.5, 1.0};
+    const double t_end = 2.7, rtol = 1e-10;
+    double expected[64];
+    size_t n_expected = history_closed_form(velocities, durations, t_end, expected, 64);
+    assert_true(n_expected >= 8);
+    /* The step at 0.6 s falls inside the first slip (0.5886 s to about 0.62 s). */
+    assert_true(expected[0] < 0.6 && expected[1] > 0.6);
+    header();
+    for (const bk_solver_backend *const *b = bk_solver_backends(); *b; ++b) {
+        scene_spec spec = paper_case(0.1, BK_SPRING_LINEAR, rtol, (*b)->name);
+        spec.t_end = t_end;
+        bk_config *c = scene_config(&spec);
+        assert_int_equal(bk_driver_set_history(&c->model->driver, velocities, durations, HISTORY_SEGMENTS), 0);
+        recorder r = {0};
+        bk_run_stats stats;
+        run_config(c, &r, &stats);
+        assert_int_equal(r.n_transitions, n_expected);
+        double worst = 0.0;
+        for (size_t j = 0; j < n_expected; ++j) {
+            assert_int_equal(r.transitions[j].to, j % 2 == 0 ? BK_MODE_SLIP_POS : BK_MODE_STICK);
+            worst = fmax(worst, fabs(r.transitions[j].t - expected[j]) / expected[j]);
+        }
+        row((*b)->name, "history", rtol, &stats, "dt/t", worst);
+        double bound = strcmp((*b)->name, "exact") == 0 ? 1e-12 : TIME_FACTOR * rtol;
+        assert_true(worst <= bound);
+        /* The hold (1.2 s to 1.7 s) passes with every block stuck: one closed-form jump. */
+        assert_true(stats.stuck_jumps >= 1);
+        assert_true(fabs(stats.energy_residual) <= ENERGY_FACTOR * rtol);
+        recorder_free(&r);
+        bk_config_free(c);
+    }
+}
+
 /* A 10-block chain (coupled, asymmetric start, mixed mu_d): driver work = elastic +
  * kinetic energy change + dissipation, to ENERGY_FACTOR * rtol; every back-end with a
  * dense linear solver, and the implicit ones with a band solver too (the analytic Jacobian
@@ -640,6 +747,7 @@ int main(void)
         cmocka_unit_test(test_cases_a_b),
         cmocka_unit_test(test_case_c),
         cmocka_unit_test(test_damped_single_block),
+        cmocka_unit_test(test_driver_history),
         cmocka_unit_test(test_chain_energy),
         cmocka_unit_test(test_arkode_tables),
         cmocka_unit_test(test_ida_two_block_chain),

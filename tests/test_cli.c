@@ -204,6 +204,7 @@ static void test_bad_inputs(void **state)
         {"velocity = 1e-3", "velocity = 1e-3\nspeed = 2", "bad.ini:12: [driver] speed:"},
         {"law = coulomb", "law = magic", "bad.ini:7: [friction] law:"},
         {"[model]", "[modle]", "bad.ini:1:"},
+        {"velocity = 1e-3", "velocities = 1e-3, 0\ndurations = 1", "bad.ini:12: [driver] durations: has 1 values, velocities has 2"},
         {"mass = 1", "mass = 1\ndamping = -1", "bad.ini:5: [block] damping: out of range, got -1"},
         {"[model]", "[model]\ncoupling_damping = -3", "bad.ini:2: [model] coupling_damping: out of range, got -3"},
         {"mass = 1", "mass = 1\ndamping = normal(1, -0.5)", "bad.ini:5: [block] damping: normal(1, -0.5) has a negative width"},
@@ -969,17 +970,20 @@ static void test_restart_equivalence(void **state)
     (void)state;
     /* gsl_rk8pd resets its stepper when a size repeats instead of making a new one: the
      * resumed run's fresh instances must compute what the reused ones do.  The damped run
-     * carries its dashpot dissipation through the checkpoints. */
-    const char *methods[] = {"cvode_adams", "exact", "gsl_rk8pd", "gsl_rk8pd"};
-    const char *extra[] = {"", "", "", "--set block.damping=20"};
-    for (size_t m = 0; m < 4; ++m) {
+     * carries its dashpot dissipation through the checkpoints; the slide-hold-slide chain
+     * resumes between and at its driver's breakpoints. */
+    const char *methods[] = {"cvode_adams", "exact", "gsl_rk8pd", "gsl_rk8pd", "gsl_rk8pd"};
+    const char *extra[] = {"", "", "", "--set block.damping=20", ""};
+    const char *configs[] = {"paper/case_b_coulomb", "paper/case_b_coulomb", "paper/case_b_coulomb",
+                             "paper/case_b_coulomb", "chains/slide_hold_slide_10"};
+    for (size_t m = 0; m < 5; ++m) {
         char reference[512], stopped[512], part[600], cmd[2048];
         snprintf(reference, sizeof reference, "%s/reference_%s_%zu.h5", tmpdir, methods[m], m);
         snprintf(stopped, sizeof stopped, "%s/stopped_%s_%zu.h5", tmpdir, methods[m], m);
         snprintf(part, sizeof part, "%s.part", stopped);
         char common[512];
-        snprintf(common, sizeof common, "configs/paper/case_b_coulomb.ini --quiet --set output.checkpoint_interval=0.1 %s",
-                 extra[m]);
+        snprintf(common, sizeof common, "configs/%s.ini --quiet --set output.checkpoint_interval=0.1 %s",
+                 configs[m], extra[m]);
         snprintf(cmd, sizeof cmd, "./bksim run %s --set solver.method=%s -o %s", common, methods[m], reference);
         assert_int_equal(run_command(cmd, NULL), 0);
         /* The same run under a wall-clock limit so short that it stops many times (each

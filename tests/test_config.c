@@ -87,6 +87,37 @@ static void test_damping_keys(void **state)
     assert_non_null(strstr(err.message, "p.ini:7: [block] damping: a prescribed scene imposes the slip rate"));
 }
 
+/* A driver history: segments from velocities and durations, t_end their sum by default. */
+static void test_driver_history_keys(void **state)
+{
+    (void)state;
+    char text[1024];
+    snprintf(text, sizeof text, "%s", minimal_config);
+    char *at = strstr(text, "velocity = 1e-3\n");
+    const char *history = "velocities = 1e-3 0 3e-3\ndurations = 2, 0.5, 1\n";
+    char rest[512];
+    snprintf(rest, sizeof rest, "%s", at + strlen("velocity = 1e-3\n"));
+    snprintf(at, sizeof text - (size_t)(at - text), "%s%s", history, rest);
+    char *t_end = strstr(text, "[run]\nt_end = 5\n");
+    *t_end = '\0';
+    bk_config *c = NULL;
+    bk_error err = {0};
+    int rc = bk_config_load_string(text, "h.ini", NULL, 0, &c, &err);
+    if (rc != BK_OK)
+        fail_msg("%s", err.message);
+    const bk_driver *d = &c->model->driver;
+    assert_int_equal(d->n_segments, 3);
+    assert_close(c->t_end, 3.5, 0, 0);
+    assert_close(d->velocity, 1e-3, 0, 0);
+    assert_close(d->segment_start[2], 2.5, 0, 0);
+    assert_close(bk_driver_position(d, 3.5), 2e-3 + 3e-3, 1e-15, 0);
+    bk_config_free(c);
+    const char *shorter[] = {"run.t_end=3"};
+    assert_int_equal(bk_config_load_string(text, "h.ini", shorter, 1, &c, &err), BK_OK);
+    assert_close(c->t_end, 3.0, 0, 0);
+    bk_config_free(c);
+}
+
 static void test_full_config(void **state)
 {
     (void)state;
@@ -450,6 +481,17 @@ static void test_rejections(void **state)
         {"mu_d = 0.5\n", "mu_d = uniform(0.7, 0.8)\n",
          "t.ini:9: [friction] mu_d: must be <= mu_s (0.6), got 0.7"},
         {"mu_d = 0.5\n", "mu_d = uniform(0.7, 0.8)\n", "(drawn for block 0)"},
+        /* Driver histories. */
+        {"velocity = 1e-3\n", "velocities = 1e-3, 0, 2e-3\ndurations = 1, 2\n",
+         "t.ini:12: [driver] durations: has 2 values, velocities has 3 (allowed: one duration per velocity)"},
+        {"velocity = 1e-3\n", "velocity = 1e-3\nvelocities = 1e-3\ndurations = 1\n",
+         "t.ini:12: [driver] velocities: give velocity (constant) or velocities (a history), not both"},
+        {"velocity = 1e-3\n", "velocities = 1e-3, 0\n", "t.ini:11: [driver] velocities: needs [driver] durations"},
+        {"velocity = 1e-3\n", "velocity = 1e-3\ndurations = 1\n",
+         "t.ini:12: [driver] durations: applies with [driver] velocities, which is not given"},
+        {"velocity = 1e-3\n", "velocities = 1e-3, 0\ndurations = 1, -2\n", "t.ini:12: [driver] durations:"},
+        {"velocity = 1e-3\n", "velocities = 1e-3, 0\ndurations = 1, 2\n",
+         "t.ini:14: [run] t_end: must be <= the driver history's length (3 s), got 5"},
         /* Dashpots. */
         {"mass = 1\n", "mass = 1\ndamping = -2\n",
          "t.ini:5: [block] damping: out of range, got -2 (allowed: 0 <= damping < inf N s/m)"},
@@ -738,6 +780,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_full_config),
         cmocka_unit_test(test_damping_keys),
+        cmocka_unit_test(test_driver_history_keys),
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(test_checkpoint_keys),
         cmocka_unit_test(test_distributions),

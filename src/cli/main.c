@@ -320,13 +320,18 @@ static int cmd_check(int argc, char **argv)
         return 0;
     if (status == 0) {
         const bk_model *m = config->model;
-        printf("%s: ok: %zu block%s, %s boundary, %s driver spring, driver %g m/s, t_end %g s, "
+        char driver[96];
+        if (m->driver.n_segments > 0)
+            snprintf(driver, sizeof driver, "a history of %zu segments", m->driver.n_segments);
+        else
+            snprintf(driver, sizeof driver, "%g m/s", m->driver.velocity);
+        printf("%s: ok: %zu block%s, %s boundary, %s driver spring, driver %s, t_end %g s, "
                "method %s, output %s\n",
                args.config_path, m->n_blocks, m->n_blocks == 1 ? "" : "s",
                m->boundary == BK_BOUNDARY_FREE    ? "free"
                : m->boundary == BK_BOUNDARY_FIXED ? "fixed"
                                                   : "periodic",
-               m->spring == BK_SPRING_LINEAR ? "linear" : "tension-only", m->driver.velocity,
+               m->spring == BK_SPRING_LINEAR ? "linear" : "tension-only", driver,
                config->t_end, config->solver.method, config->output.path);
     }
     bk_config_free(config);
