@@ -304,7 +304,7 @@ static void build_chain(loader *ld, bk_config *c)
     bk_model_finalize(m);
     check_initial_energy(ld, m);
     entry *t_end = bk_config_lookup(ld, "run", "t_end");
-    if (isnan(history) || !m->driver.n_segments) {
+    if (isnan(history)) {
         c->t_end = value_of(ld, "run", "t_end");
     } else {
         /* The history is the run's schedule: t_end defaults to its length, and may not pass it. */

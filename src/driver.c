@@ -87,22 +87,6 @@ double bk_driver_velocity(const bk_driver *driver, double t)
     return bk_driver_segment_velocity(driver, bk_driver_segment(driver, t));
 }
 
-double bk_driver_displacement(const bk_driver *driver, double t0, double t1)
-{
-    if (driver->n_segments == 0)
-        return driver->velocity * (t1 - t0);
-    if (t1 < t0)
-        return -bk_driver_displacement(driver, t1, t0);
-    /* Segment by segment from t0, so only the motion between the two times is summed. */
-    size_t k = bk_driver_segment(driver, t0), last = bk_driver_segment(driver, t1);
-    double sum = 0.0, from = t0;
-    for (; k < last; ++k) {
-        sum += driver->segment_velocity[k] * (driver->segment_start[k + 1] - from);
-        from = driver->segment_start[k + 1];
-    }
-    return sum + driver->segment_velocity[last] * (t1 - from);
-}
-
 /* Earliest time in [t0, t_end) when the straight line through (t0, here) at velocity v
  * reaches position; +INFINITY if not before t_end. */
 static double time_on_line(double t0, double here, double v, double position, double t_end)
@@ -126,8 +110,9 @@ double bk_driver_time_at(const bk_driver *driver, double t0, double position)
         double t = (position - driver->start_position) / driver->velocity;
         return t < t0 ? t0 : t;
     }
-    for (size_t k = bk_driver_segment(driver, t0); k < driver->n_segments; ++k) {
-        double from = k == bk_driver_segment(driver, t0) ? t0 : driver->segment_start[k];
+    size_t first = bk_driver_segment(driver, t0);
+    for (size_t k = first; k < driver->n_segments; ++k) {
+        double from = k == first ? t0 : driver->segment_start[k];
         double end = k + 1 < driver->n_segments ? driver->segment_start[k + 1] : INFINITY;
         double t = time_on_line(from, bk_driver_segment_position(driver, k, from), driver->segment_velocity[k],
                                 position, end);

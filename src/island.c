@@ -115,13 +115,15 @@ static inline double coupling_force(const bk_island *island, const double *y, si
     return force;
 }
 
-/* Dashpot force on block i moving at v_i (bk_model_damping_force on the island's vector). */
-static inline double damping_force(const bk_island *island, const double *y, size_t i, double v_i)
+/* Dashpot force on block i (bk_model_damping_force on the island's vector); nothing is looked
+ * up without dashpots, as the right-hand side and roots run for every scene. */
+static inline double damping_force(const bk_island *island, const double *y, size_t i)
 {
     const bk_scene *scene = island->scene;
     if (!scene->damped)
         return 0.0;
     const bk_model *model = scene->model;
+    double v_i = velocity(island, y, (long)i);
     double force = -model->blocks[i].damping * v_i;
     double etac = model->coupling_damping;
     if (etac > 0.0) {
@@ -152,7 +154,8 @@ void bk_island_restart(bk_island *island, double t, double *y)
     island->n_stateful = 0;
     island->affine = scene->affine && !scene->full_layout;
     island->driver_segment = bk_driver_segment(&model->driver, t);
-    double driver_pos = bk_driver_position(&model->driver, t);
+    double driver_pos = bk_driver_segment_position(&model->driver, island->driver_segment, t);
+    double driver_speed = bk_driver_segment_velocity(&model->driver, island->driver_segment);
     for (size_t k = 0; k < island->len; ++k) {
         size_t i = bk_island_block(island, k);
         const bk_block *b = &model->blocks[i];
@@ -163,7 +166,7 @@ void bk_island_restart(bk_island *island, double t, double *y)
         /* At the kink itself the spring is taut if the driver is pulling away. */
         scene->taut[i] = model->spring == BK_SPRING_LINEAR || extension > 0.0 ||
                          (extension == 0.0 &&
-                          bk_driver_velocity(&model->driver, t) - (dir != 0 ? scene->v[i] : 0.0) > 0.0);
+                          driver_speed - (dir != 0 ? scene->v[i] : 0.0) > 0.0);
         if (dir != 0) {
             scene->slot[i] = next;
             island->active_mass[island->n_active] = b->mass;
@@ -296,7 +299,7 @@ static void rhs_parts(const bk_island *island, double t, const double *y, double
         double dir = (double)scene->mode[i];
         double spring = driver_force(scene, i, x_i, driver_pos);
         double applied = spring + coupling_force(island, y, i, x_i);
-        double dashpots = damping_force(island, y, i, v_i);
+        double dashpots = damping_force(island, y, i);
         double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
                                                 block_state(island, y, i));
         ydot[s] = v_i;
@@ -317,7 +320,8 @@ static void rhs_parts(const bk_island *island, double t, const double *y, double
                 size_t s = scene->slot[i];
                 ydot[s] = y[s + 1];       /* xi' = v */
                 ydot[s + 1] = -y[s + 1]; /* 0 = -v, algebraic */
-                damping_rate -= y[s + 1] * damping_force(island, y, i, y[s + 1]);
+                if (scene->damped)
+                    damping_rate -= y[s + 1] * damping_force(island, y, i);
             }
         }
     for (size_t k = 0; k < island->n_stateful; ++k) {
@@ -391,7 +395,7 @@ static void damping_jacobian(const bk_island *island, const double *y, size_t i,
                 put(matrix, s + 1, scene->slot[partners[p]] + 1, etac / m);
     }
     if (with_energy)
-        put(matrix, island->n_y - 1, s + 1, -2.0 * damping_force(island, y, i, y[s + 1]));
+        put(matrix, island->n_y - 1, s + 1, -2.0 * damping_force(island, y, i));
 }
 
 /* The Jacobian of the whole right-hand side, or (friction_only) of its friction and dashpot
@@ -500,7 +504,7 @@ int bk_island_roots(double t, const double *y, double *g, void *user)
         double *gi = &g[R * k];
         double x_i = position(island, y, (long)i);
         double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) +
-                         damping_force(island, y, i, velocity(island, y, (long)i));
+                         damping_force(island, y, i);
         const double *state = block_state(island, y, i);
         size_t s = scene->slot[i];
         if (!scene->can_stick[i]) {
@@ -538,7 +542,7 @@ double bk_island_slip_acceleration(const bk_island *island, size_t i, double t, 
     double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
     double dir = (double)scene->mode[i];
     double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) +
-                     damping_force(island, y, i, v_i);
+                     damping_force(island, y, i);
     double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
                                             block_state(island, y, i));
     return dir * (applied - dir * friction) / b->mass;

@@ -203,15 +203,9 @@ static int schedule(run_ctx *ctx)
             if (t_stop < ctx->t_end) {
                 /* A driver breakpoint restarts everything on the next segment's line (its
                  * quiet blocks' failure times too, so the next breakpoint is set first). */
-                int breakpoint = t_stop == ctx->t_breakpoint;
-                if (breakpoint)
+                if (t_stop == ctx->t_breakpoint)
                     ctx->t_breakpoint = bk_driver_next_breakpoint(&ctx->model->driver, t_stop);
-                if (t_stop == bk_run_checkpoint_time(ctx))
-                    rc = bk_run_checkpoint(ctx, t_stop);
-                else if ((rc = bk_run_unpack_all(ctx, t_stop)) == BK_OK) {
-                    bk_run_rebase_energy(ctx, t_stop);
-                    rc = bk_run_partition_all(ctx, t_stop);
-                }
+                rc = bk_run_restart_all(ctx, t_stop, t_stop == bk_run_checkpoint_time(ctx));
                 break;
             }
             if ((rc = bk_run_unpack_all(ctx, ctx->t_end)) != BK_OK)

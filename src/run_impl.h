@@ -222,9 +222,10 @@ void bk_run_enter_stuck(run_ctx *ctx, size_t i, double t);
 void bk_run_energy_totals(run_ctx *ctx, double t, const bk_energy *islands);
 /* Statistics so far, the resumed run's included. */
 void bk_run_collect_stats(const run_ctx *ctx, bk_run_stats *stats, double cpu0);
-/* The state at a checkpoint time t (islands stopped there): recorded when the wall-clock
- * interval has passed, then every island restarted, as a resumed run will, written or not. */
-int bk_run_checkpoint(run_ctx *ctx, double t);
+/* Every island restarted at t (islands stopped there), as a resumed run starts.  At a restart
+ * point (restart_point) the state is first recorded as a checkpoint when the wall-clock
+ * interval has passed; otherwise (a driver breakpoint) only the restart. */
+int bk_run_restart_all(run_ctx *ctx, double t, int restart_point);
 /* The state of a checkpoint, back into the chain. */
 int bk_run_resume(run_ctx *ctx, const bk_checkpoint *cp);
 /* Close every stuck interval's books at t: the closed totals take everything so far and the

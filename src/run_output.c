@@ -246,12 +246,14 @@ void bk_run_collect_stats(const run_ctx *ctx, bk_run_stats *stats, double cpu0)
     stats->cpu_time = base->cpu_time + (double)(clock() - (clock_t)cpu0) / CLOCKS_PER_SEC;
 }
 
-int bk_run_checkpoint(run_ctx *ctx, double t)
+int bk_run_restart_all(run_ctx *ctx, double t, int restart_point)
 {
     int rc = bk_run_unpack_all(ctx, t);
     if (rc != BK_OK)
         return rc;
     bk_run_rebase_energy(ctx, t);
+    if (!restart_point)
+        return bk_run_partition_all(ctx, t);
     ctx->next_checkpoint++;
     ctx->restart_work = 0.0;
     ctx->t_restart = INFINITY;

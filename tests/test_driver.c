@@ -1,6 +1,6 @@
 /* The driver's position: constant velocity, and a history of piecewise-constant velocities
  * (segments found at and between breakpoints, positions continuous across them, the time the
- * driver reaches a position across holds and reversals, displacements summed per segment). */
+ * driver reaches a position across holds and reversals). */
 #include <math.h>
 
 #include "bk_test.h"
@@ -16,7 +16,6 @@ static void test_constant(void **state)
     assert_true(isinf(bk_driver_next_breakpoint(&d, 0.0)));
     assert_close(bk_driver_time_at(&d, 0.0, 1e-3 + 2.385e-3), 1.0, 1e-15, 0);
     assert_true(isinf(bk_driver_time_at(&d, 0.0, 0.0))); /* behind it */
-    assert_close(bk_driver_displacement(&d, 1.0, 3.0), 2.0 * 2.385e-3, 1e-15, 0);
 }
 
 /* Slide, hold, slide back, slide on: 0..1 s at 1 mm/s, 1..3 s held, 3..3.5 s at -2 mm/s,
@@ -58,10 +57,6 @@ static void test_history(void **state)
     assert_close(bk_driver_time_at(&d, 1.2, 1.0e-3), 3.25, 1e-12, 0);
     assert_close(bk_driver_time_at(&d, 1.2, 2.0e-3), 3.5 + 1.5e-3 / 4e-3, 1e-12, 0);
     assert_true(isinf(bk_driver_time_at(&d, 3.6, 0.1e-3)));
-    /* Displacement: the sum of the segments between the two times, either way round. */
-    assert_close(bk_driver_displacement(&d, 0.5, 4.0), 2.5e-3 - 1.0e-3, 1e-12, 0);
-    assert_close(bk_driver_displacement(&d, 4.0, 0.5), -1.5e-3, 1e-12, 0);
-    assert_close(bk_driver_displacement(&d, 1.5, 2.5), 0.0, 0, 0);
     bk_driver_free_history(&d);
     assert_int_equal(d.n_segments, 0);
     assert_null(d.segment_start);

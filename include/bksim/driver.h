@@ -37,8 +37,6 @@ double bk_driver_next_breakpoint(const bk_driver *driver, double t);
 
 double bk_driver_position(const bk_driver *driver, double t);  /* m */
 double bk_driver_velocity(const bk_driver *driver, double t);  /* m/s */
-/* Driver displacement from t0 to t1, computed without cancellation of large positions. */
-double bk_driver_displacement(const bk_driver *driver, double t0, double t1);
 /* Earliest time >= t0 at which the driver is at `position`; +INFINITY if never. */
 double bk_driver_time_at(const bk_driver *driver, double t0, double position);
 
