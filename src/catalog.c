@@ -11,7 +11,8 @@
 
 struct bk_catalog {
     size_t n;
-    int ring;
+    size_t rows, cols;    /* the lattice (a chain: 1 x n) */
+    int ring_rows, ring_cols;
     double magnitude_offset;
     /* Per block. */
     double *x_onset;      /* m, position where its current slip episode began */
@@ -29,15 +30,27 @@ struct bk_catalog {
     bk_event event;
     int32_t *involved;    /* its blocks, in the order they first slipped */
     size_t n_involved, involved_capacity;
+    int32_t *lines;       /* a lattice event's columns, scratch */
+    size_t lines_capacity;
 };
 
 bk_catalog *bk_catalog_create(size_t n_blocks, int ring, double magnitude_offset)
 {
+    return bk_catalog_create_lattice(1, n_blocks, 0, ring, magnitude_offset);
+}
+
+bk_catalog *bk_catalog_create_lattice(size_t rows, size_t cols, int ring_rows, int ring_cols,
+                                      double magnitude_offset)
+{
     bk_catalog *c = calloc(1, sizeof *c);
     if (!c)
         return NULL;
+    size_t n_blocks = rows * cols;
     c->n = n_blocks;
-    c->ring = ring;
+    c->rows = rows;
+    c->cols = cols;
+    c->ring_rows = ring_rows;
+    c->ring_cols = ring_cols;
     c->magnitude_offset = magnitude_offset;
     c->x_onset = malloc(n_blocks * sizeof *c->x_onset);
     c->first_force = malloc(n_blocks * sizeof *c->first_force);
@@ -64,6 +77,7 @@ void bk_catalog_free(bk_catalog *c)
     free(c->seen);
     free(c->slipping);
     free(c->involved);
+    free(c->lines);
     free(c);
 }
 
@@ -109,34 +123,71 @@ static int compare_blocks(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The extent: on a chain the first and last block; on a ring the shorter arc covering the
- * blocks, the complement of the largest gap between two of them. */
-static void extent(bk_catalog *c, bk_event *e)
+/* The first and last of k distinct sorted lines along a direction of len lines: on a ring
+ * the shorter arc covering them, the complement of the widest gap between two of them. */
+static void span(const int32_t *line, size_t k, size_t len, int ring, int32_t *first, int32_t *last)
 {
-    size_t k = c->n_involved;
-    qsort(c->involved, k, sizeof *c->involved, compare_blocks);
-    e->left = c->involved[0];
-    e->right = c->involved[k - 1];
-    if (!c->ring || k == 1)
+    *first = line[0];
+    *last = line[k - 1];
+    if (!ring || k == 1)
         return;
-    /* The gap after the last block wraps round to the first. */
-    int64_t widest = (int64_t)c->n - c->involved[k - 1] + c->involved[0];
+    /* The gap after the last line wraps round to the first. */
+    int64_t widest = (int64_t)len - line[k - 1] + line[0];
     for (size_t j = 1; j < k; ++j) {
-        int64_t gap = (int64_t)c->involved[j] - c->involved[j - 1];
+        int64_t gap = (int64_t)line[j] - line[j - 1];
         if (gap > widest) {
             widest = gap;
-            e->left = c->involved[j];
-            e->right = c->involved[j - 1];
+            *first = line[j];
+            *last = line[j - 1];
         }
     }
 }
 
-static void close_event(bk_catalog *c, double t_end, bk_event *out)
+/* Sort and drop repeats; returns the count left. */
+static size_t distinct(int32_t *values, size_t k)
+{
+    qsort(values, k, sizeof *values, compare_blocks);
+    size_t kept = 0;
+    for (size_t j = 0; j < k; ++j)
+        if (kept == 0 || values[j] != values[kept - 1])
+            values[kept++] = values[j];
+    return kept;
+}
+
+/* The extent: on a chain the first and last block (on a ring the shorter arc); on a lattice
+ * the bounding box, left its top-left corner and right its bottom-right one (each
+ * direction's span as a chain's).  Returns -1 when out of memory. */
+static int extent(bk_catalog *c, bk_event *e)
+{
+    size_t k = c->n_involved;
+    qsort(c->involved, k, sizeof *c->involved, compare_blocks);
+    if (c->rows == 1) {
+        span(c->involved, k, c->n, c->ring_cols, &e->left, &e->right);
+        return 0;
+    }
+    int32_t *lines = bk_grow_array(c->lines, &c->lines_capacity, k, sizeof *lines, 64);
+    if (!lines)
+        return -1;
+    c->lines = lines;
+    int32_t cols = (int32_t)c->cols, row_first, row_last, col_first, col_last;
+    for (size_t j = 0; j < k; ++j)
+        lines[j] = c->involved[j] / cols;
+    span(lines, distinct(lines, k), c->rows, c->ring_rows, &row_first, &row_last);
+    for (size_t j = 0; j < k; ++j)
+        lines[j] = c->involved[j] % cols;
+    span(lines, distinct(lines, k), c->cols, c->ring_cols, &col_first, &col_last);
+    e->left = row_first * cols + col_first;
+    e->right = row_last * cols + col_last;
+    return 0;
+}
+
+static int close_event(bk_catalog *c, double t_end, bk_event *out)
 {
     bk_event *e = &c->event;
     e->t_end = t_end;
     e->n_blocks = (int32_t)c->n_involved;
-    extent(c, e); /* sorts the blocks: the sum below goes in block order, as after a restore */
+    if (extent(c, e) != 0) /* sorts the blocks: the sum below goes in block order, as after a restore */
+        return BK_ERR_NOMEM;
     double drop = 0.0;
     for (size_t j = 0; j < c->n_involved; ++j)
         drop += c->first_force[c->involved[j]] - c->last_force[c->involved[j]];
@@ -145,6 +196,7 @@ static void close_event(bk_catalog *c, double t_end, bk_event *out)
     *out = *e;
     c->open = 0;
     c->pending = 0;
+    return BK_OK;
 }
 
 int bk_catalog_begin(bk_catalog *c, double t, const int8_t *mode, const double *x, const double *v,
@@ -165,7 +217,9 @@ int bk_catalog_add(bk_catalog *c, const bk_transition *tr, bk_event *event, int 
     if (tr->block < 0 || (size_t)tr->block >= c->n)
         return BK_ERR_INVALID;
     if (c->pending && tr->t > c->t_pending) {
-        close_event(c, c->t_pending, event);
+        int rc = close_event(c, c->t_pending, event);
+        if (rc != BK_OK)
+            return rc;
         *done = 1;
     }
     size_t i = (size_t)tr->block;
@@ -186,10 +240,8 @@ int bk_catalog_add(bk_catalog *c, const bk_transition *tr, bk_event *event, int 
 int bk_catalog_finish(bk_catalog *c, double t, const double *x, bk_catalog_force_fn force,
                       const void *user, bk_event *event)
 {
-    if (c->pending) {
-        close_event(c, c->t_pending, event);
-        return 1;
-    }
+    if (c->pending)
+        return close_event(c, c->t_pending, event) == BK_OK ? 1 : BK_ERR_NOMEM;
     if (!c->open)
         return 0;
     /* Still running: its open episodes counted to t, its blocks' forces there. */
@@ -201,7 +253,8 @@ int bk_catalog_finish(bk_catalog *c, double t, const double *x, bk_catalog_force
         }
     }
     c->n_slipping = 0;
-    close_event(c, t, event);
+    if (close_event(c, t, event) != BK_OK)
+        return BK_ERR_NOMEM;
     event->complete = 0;
     return 1;
 }

@@ -124,12 +124,17 @@ int bk_config_load_string(const char *text, const char *name, const char *const 
         free_loader(&ld);
         return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory while parsing", name);
     }
-    /* n_blocks first: block indices are checked against it. */
-    entry *n_entry = bk_config_lookup(&ld, "model", "n_blocks");
-    long n_blocks = 0;
-    if (n_entry && bk_config_check_value(&ld, n_entry, bk_config_find_key("model", "n_blocks"),
-                                         &bk_config_find_key("model", "n_blocks")->param) == 0)
-        n_blocks = (long)n_entry->number;
+    /* The number of blocks first: block indices are checked against it (n_blocks, else
+     * rows * cols; 0 when neither is known, and the build reports why). */
+    long shape[3] = {0, 0, 0};
+    static const char *const shape_keys[] = {"n_blocks", "rows", "cols"};
+    for (size_t k = 0; k < 3; ++k) {
+        entry *e = bk_config_lookup(&ld, "model", shape_keys[k]);
+        const key_def *def = bk_config_find_key("model", shape_keys[k]);
+        if (e && bk_config_check_value(&ld, e, def, &def->param) == 0)
+            shape[k] = (long)e->number;
+    }
+    long n_blocks = shape[0] ? shape[0] : shape[1] * shape[2];
     bk_config_check_entries(&ld, n_blocks);
     bk_config *c = NULL;
     if (ld.error_rank == LONG_MAX)

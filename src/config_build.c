@@ -241,20 +241,85 @@ static double build_driver(loader *ld, bk_model *m)
     return total;
 }
 
-/* The chain: model, blocks, friction, driver. */
+/* The shape: n_blocks, rows and cols, any two of them implying the third (one alone: n_blocks,
+ * a chain).  Returns 0 after an error, reported. */
+static size_t build_shape(loader *ld, size_t *rows, size_t *cols)
+{
+    entry *n_entry = bk_config_lookup(ld, "model", "n_blocks");
+    entry *r_entry = bk_config_lookup(ld, "model", "rows");
+    entry *c_entry = bk_config_lookup(ld, "model", "cols");
+    if (!n_entry && !(r_entry && c_entry)) {
+        const key_def *def = bk_config_find_key("model", "n_blocks");
+        report_missing(ld, "model", &def->param, def);
+        return 0;
+    }
+    size_t n = n_entry ? (size_t)n_entry->number : 0;
+    *rows = r_entry ? (size_t)r_entry->number : 0;
+    *cols = c_entry ? (size_t)c_entry->number : 0;
+    if (!r_entry && !c_entry) {
+        *rows = 1;
+        *cols = n;
+        return n;
+    }
+    if (r_entry && c_entry) {
+        /* Both at most BK_CONFIG_MAX_BLOCKS: the product fits a double exactly. */
+        double product = r_entry->number * c_entry->number;
+        if (product > (double)BK_CONFIG_MAX_BLOCKS) {
+            bk_config_report_entry(ld, c_entry, "rows * cols = %.0f blocks (allowed: at most %ld)", product,
+                                   (long)BK_CONFIG_MAX_BLOCKS);
+            return 0;
+        }
+        if (n_entry && product != n_entry->number) {
+            bk_config_report_entry(ld, n_entry, "%zu blocks, but rows * cols = %zu * %zu = %.0f (allowed: n_blocks = "
+                                   "rows * cols, or leave n_blocks out)", n, *rows, *cols, product);
+            return 0;
+        }
+        return *rows * *cols;
+    }
+    entry *given = r_entry ? r_entry : c_entry;
+    size_t per = (size_t)given->number;
+    if (n % per != 0) {
+        bk_config_report_entry(ld, given, "%zu does not divide n_blocks = %zu (allowed: a divisor of n_blocks, "
+                               "or give both rows and cols)", per, n);
+        return 0;
+    }
+    if (r_entry)
+        *cols = n / per;
+    else
+        *rows = n / per;
+    return n;
+}
+
+/* A boundary key's value: its own entry, else `boundary`; on a chain (no rows key) the rows
+ * direction is free unless boundary_rows is given. */
+static bk_boundary boundary_of(loader *ld, const char *key, int chain)
+{
+    entry *own = bk_config_lookup(ld, "model", key);
+    if (own)
+        return (bk_boundary)(int)own->number;
+    if (chain && strcmp(key, "boundary_rows") == 0)
+        return BK_BOUNDARY_FREE;
+    return (bk_boundary)(int)value_of(ld, "model", "boundary");
+}
+
+/* The chain or lattice: model, blocks, friction, driver. */
 static void build_chain(loader *ld, bk_config *c)
 {
-    double n_value = value_of(ld, "model", "n_blocks");
-    if (!(n_value >= 1))
+    size_t rows = 1, cols = 1;
+    size_t n = build_shape(ld, &rows, &cols);
+    if (n == 0)
         return; /* reported */
-    size_t n = (size_t)n_value;
     bk_model *m = bk_model_create(n);
     if (!m) {
         bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory for %zu blocks", ld->name, n);
         return;
     }
     c->model = m;
-    m->boundary = (bk_boundary)(int)value_of(ld, "model", "boundary");
+    m->rows = rows;
+    m->cols = cols;
+    int chain = bk_config_lookup(ld, "model", "rows") == NULL;
+    m->boundary_cols = boundary_of(ld, "boundary_cols", chain);
+    m->boundary_rows = boundary_of(ld, "boundary_rows", chain);
     m->coupling_stiffness = value_of(ld, "model", "coupling_stiffness");
     m->coupling_damping = value_of(ld, "model", "coupling_damping");
     m->gravity = value_of(ld, "model", "gravity");
@@ -339,9 +404,12 @@ static void build_prescribed(loader *ld, bk_config *c)
         bk_config_report_entry(ld, lengths, "has %zu values, slip_rates has %zu", (size_t)lengths->number, n);
         return;
     }
-    entry *n_blocks = bk_config_lookup(ld, "model", "n_blocks");
-    if (n_blocks && n_blocks->number != 1.0)
-        bk_config_report_entry(ld, n_blocks, "a prescribed scene has one block, got %s", n_blocks->value);
+    static const char *const shape[] = {"n_blocks", "rows", "cols"};
+    for (size_t k = 0; k < sizeof shape / sizeof shape[0]; ++k) {
+        entry *e = bk_config_lookup(ld, "model", shape[k]);
+        if (e && e->number != 1.0)
+            bk_config_report_entry(ld, e, "a prescribed scene has one block, got %s (allowed: 1)", e->value);
+    }
     /* The slip rate is imposed, so a dashpot would change nothing a prescribed run reports. */
     static const char *const dashpots[][2] = {{"block", "damping"}, {"block.0", "damping"}, {"model", "coupling_damping"}};
     for (size_t d = 0; d < sizeof dashpots / sizeof dashpots[0]; ++d) {

@@ -11,6 +11,7 @@
 #include "bksim/config.h"
 
 #define SECTION_LEN 64
+#define BK_CONFIG_MAX_BLOCKS 1000000L
 #define KEY_LEN 64
 
 /* --- the key table (config_keys.c) ------------------------------------------------------ */

@@ -11,7 +11,7 @@
 #include "config_impl.h"
 #include "output/layout.h"
 
-#define MAX_BLOCKS 1000000L
+
 
 /* --- the key table ---------------------------------------------------------------------- */
 
@@ -44,9 +44,22 @@ static const char *law_name(size_t i)
 #define INT(sec, k, def, lo, hi, fl, doc) {sec, {k, "1", def, lo, hi, fl, doc}, BK_KEY_INTEGER, NULL, NULL, NULL}
 
 static const key_def keys[] = {
-    INT("model", "n_blocks", NAN, 1, MAX_BLOCKS, BK_PARAM_REQUIRED, "number of blocks in the chain"),
-    {"model", {"boundary", "", 0, 0, 0, 0, "chain ends: free, fixed (tied to walls at 0) or periodic (a ring)"},
+    {"model", {"n_blocks", "1", NAN, 1, BK_CONFIG_MAX_BLOCKS, 0, "number of blocks (rows * cols on a lattice)"},
+     BK_KEY_INTEGER, NULL, NULL, "required, or rows and cols"},
+    {"model", {"rows", "1", NAN, 1, BK_CONFIG_MAX_BLOCKS, 0,
+               "rows of a 2D lattice (block i at row i / cols, column i % cols); 1 is a chain"},
+     BK_KEY_INTEGER, NULL, NULL, "1, or n_blocks / cols"},
+    {"model", {"cols", "1", NAN, 1, BK_CONFIG_MAX_BLOCKS, 0, "columns of a 2D lattice: blocks per row"},
+     BK_KEY_INTEGER, NULL, NULL, "n_blocks / rows"},
+    {"model", {"boundary", "", 0, 0, 0, 0,
+               "edges: free, fixed (tied to walls at 0) or periodic (a ring, a torus); a chain's ends, or a "
+               "lattice's four edges"},
      BK_KEY_CHOICE, boundary_names, NULL, "free"},
+    {"model", {"boundary_cols", "", 0, 0, 0, 0, "the edges at the first and last column (a chain's ends)"},
+     BK_KEY_CHOICE, boundary_names, NULL, "boundary"},
+    {"model", {"boundary_rows", "", 0, 0, 0, 0,
+               "the edges at the first and last row; a chain (no rows key) has none unless given here"},
+     BK_KEY_CHOICE, boundary_names, NULL, "boundary, or free on a chain"},
     NUM("model", "coupling_stiffness", "N/m", 0.0, 0.0, INFINITY, 0, "stiffness of the springs between neighbours"),
     NUM("model", "coupling_damping", "N s/m", 0.0, 0.0, INFINITY, 0,
         "dashpot in parallel with every coupling spring (Carlson-Langer viscosity): force coupling_damping * (v_j - v_i)"),
@@ -271,7 +284,7 @@ static void write_row(FILE *out, const key_def *def, const bk_param *param)
 void bk_config_write_reference(FILE *out)
 {
     static const char *const notes[] = {
-        "model", "The chain.",
+        "model", "The chain, or the 2D lattice.",
         "block", "Defaults for every block; a `[block.I]` section (I = 0 .. n_blocks-1) overrides them for block I. "
                  "Any numeric key here or in `[friction]` may be a distribution drawn per block at load time from "
                  "`[model] seed`: `uniform(a, b)`, `normal(mean, sd)` or `lognormal(mu, sigma)` (of the log); a draw "

@@ -25,11 +25,11 @@ size_t bk_island_max_y(const bk_scene *scene, size_t len)
     return len * (2 + scene->max_block_state) + scene->n_energy;
 }
 
-size_t bk_island_y_length(const bk_scene *scene, size_t start, size_t len)
+size_t bk_island_y_length(const bk_scene *scene, const size_t *blocks, size_t len)
 {
     size_t n_y = scene->n_energy;
     for (size_t k = 0; k < len; ++k) {
-        size_t i = start + k < scene->n ? start + k : start + k - scene->n;
+        size_t i = blocks[k];
         if (!bk_scene_stuck(scene, i) || scene->full_layout)
             n_y += 2;
         n_y += scene->model->blocks[i].law->n_state;
@@ -44,13 +44,14 @@ int bk_island_reserve(bk_island *island, size_t len)
     size_t max_y = bk_island_max_y(island->scene, len);
     size_t R = island->scene->roots_per_block;
     /* One block for every layout array: an island's step reads them together. */
-    size_t bytes = len * (2 * sizeof(size_t) + sizeof(double)) + max_y * sizeof(double) +
+    size_t bytes = len * (3 * sizeof(size_t) + sizeof(double)) + max_y * sizeof(double) +
                    R * len * sizeof(int);
     char *block = malloc(bytes);
     if (!block)
         return -1;
-    free(island->active);
-    island->active = (size_t *)(void *)block;
+    free(island->blocks);
+    island->blocks = (size_t *)(void *)block;
+    island->active = island->blocks + len;
     island->stateful = island->active + len;
     island->active_mass = (double *)(void *)(island->stateful + len);
     island->differential_id = island->active_mass + len;
@@ -61,8 +62,8 @@ int bk_island_reserve(bk_island *island, size_t len)
 
 void bk_island_free(bk_island *island)
 {
-    free(island->active); /* the block holding every layout array */
-    island->active = island->stateful = NULL;
+    free(island->blocks); /* the block holding every layout array */
+    island->blocks = island->active = island->stateful = NULL;
     island->active_mass = island->differential_id = NULL;
     island->root_direction = NULL;
     island->capacity = 0;
@@ -108,10 +109,10 @@ static inline double coupling_force(const bk_island *island, const double *y, si
     if (kc == 0.0)
         return 0.0;
     double force = 0.0;
-    if (scene->left[i] != -1)
-        force += kc * (position(island, y, scene->left[i]) - x_i);
-    if (scene->right[i] != -1)
-        force += kc * (position(island, y, scene->right[i]) - x_i);
+    const long *partner = bk_scene_partners(scene, i);
+    for (size_t d = 0; d < scene->n_directions; ++d)
+        if (partner[d] != -1)
+            force += kc * (position(island, y, partner[d]) - x_i);
     return force;
 }
 
@@ -127,10 +128,10 @@ static inline double damping_force(const bk_island *island, const double *y, siz
     double force = -model->blocks[i].damping * v_i;
     double etac = model->coupling_damping;
     if (etac > 0.0) {
-        if (scene->left[i] != -1)
-            force += etac * (velocity(island, y, scene->left[i]) - v_i);
-        if (scene->right[i] != -1)
-            force += etac * (velocity(island, y, scene->right[i]) - v_i);
+        const long *partner = bk_scene_partners(scene, i);
+        for (size_t d = 0; d < scene->n_directions; ++d)
+            if (partner[d] != -1)
+                force += etac * (velocity(island, y, partner[d]) - v_i);
     }
     return force;
 }
@@ -142,6 +143,28 @@ static inline const double *block_state(const bk_island *island, const double *y
     if (b->law->n_state == 0)
         return NULL;
     return y ? &y[scene->state_slot[i]] : &scene->state[b->state_offset];
+}
+
+/* The Jacobian's half bandwidth: within a block and to its chain neighbours (`local`), and
+ * between the integrated blocks coupled right or down (on a lattice, a row apart).  A
+ * periodic seam, where the partner comes earlier in the island's order, is left out: the
+ * band solver drops that corner, as an approximate Newton matrix may. */
+static size_t half_bandwidth(const bk_island *island, size_t local)
+{
+    const bk_scene *scene = island->scene;
+    size_t width = local;
+    if (scene->n_directions <= 2)
+        return width; /* chain neighbours are adjacent in the layout */
+    for (size_t k = 0; k < island->len; ++k) {
+        size_t i = island->blocks[k], s = scene->slot[i];
+        if (s == BK_NO_SLOT)
+            continue;
+        long p = bk_scene_partners(scene, i)[BK_DOWN];
+        if (p >= 0 && scene->island_of[p] == island->id && scene->slot[p] != BK_NO_SLOT && scene->slot[p] > s &&
+            scene->slot[p] - s + 1 > width)
+            width = scene->slot[p] - s + 1;
+    }
+    return width;
 }
 
 void bk_island_restart(bk_island *island, double t, double *y)
@@ -214,7 +237,7 @@ void bk_island_restart(bk_island *island, double t, double *y)
         island->differential_id[next + e] = 1.0;
     }
     island->n_y = next + scene->n_energy;
-    island->half_bandwidth = 3 + max_state;
+    island->half_bandwidth = half_bandwidth(island, 3 + max_state);
     island->t_ref = t;
     for (size_t k = 0; k < island->n_active; ++k) {
         size_t i = island->active[k];
@@ -387,12 +410,12 @@ static void damping_jacobian(const bk_island *island, const double *y, size_t i,
     const bk_model *model = scene->model;
     double etac = model->coupling_damping, m = model->blocks[i].mass;
     if (!bk_scene_stuck(scene, i)) {
-        put(matrix, s + 1, s + 1, -(model->blocks[i].damping + etac * bk_model_coupling_count(model, i)) / m);
-        const long partners[2] = {scene->left[i], scene->right[i]};
-        for (size_t p = 0; p < 2 && etac > 0.0; ++p)
-            if (partners[p] >= 0 && scene->slot[partners[p]] != BK_NO_SLOT &&
-                scene->island_of[partners[p]] == island->id)
-                put(matrix, s + 1, scene->slot[partners[p]] + 1, etac / m);
+        put(matrix, s + 1, s + 1, -(model->blocks[i].damping + etac * bk_scene_coupling_count(scene, i)) / m);
+        const long *partner = bk_scene_partners(scene, i);
+        for (size_t d = 0; d < scene->n_directions && etac > 0.0; ++d)
+            if (partner[d] >= 0 && scene->slot[partner[d]] != BK_NO_SLOT &&
+                scene->island_of[partner[d]] == island->id)
+                put(matrix, s + 1, scene->slot[partner[d]] + 1, etac / m);
     }
     if (with_energy)
         put(matrix, island->n_y - 1, s + 1, -2.0 * damping_force(island, y, i));
@@ -416,12 +439,12 @@ static void jacobian_parts(const bk_island *island, const double *y, int frictio
         if (!friction_only) {
             put(matrix, s, s + 1, 1.0); /* xi' = v */
             /* Springs: the block's own stiffness, and its partners integrated here. */
-            put(matrix, s + 1, s, -(spring + kc * bk_model_coupling_count(model, i)) / m);
-            const long partners[2] = {scene->left[i], scene->right[i]};
-            for (size_t p = 0; p < 2 && kc > 0.0; ++p)
-                if (partners[p] >= 0 && scene->slot[partners[p]] != BK_NO_SLOT &&
-                    scene->island_of[partners[p]] == island->id)
-                    put(matrix, s + 1, scene->slot[partners[p]], kc / m);
+            put(matrix, s + 1, s, -(spring + kc * bk_scene_coupling_count(scene, i)) / m);
+            const long *partner = bk_scene_partners(scene, i);
+            for (size_t d = 0; d < scene->n_directions && kc > 0.0; ++d)
+                if (partner[d] >= 0 && scene->slot[partner[d]] != BK_NO_SLOT &&
+                    scene->island_of[partner[d]] == island->id)
+                    put(matrix, s + 1, scene->slot[partner[d]], kc / m);
         }
         /* Friction: -dir F(dir v, state) / m. */
         const double *state = block_state(island, y, i);

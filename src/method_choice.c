@@ -29,7 +29,8 @@
  * So exact up to 1e3 blocks (2x faster on the usual heterogeneous chain, 3x slower at
  * worst); beyond, the worst case grows with N and the integrator is the safe default.  A
  * ring that slips all round is one cyclic cluster, dense and p^3 per restart (1e3 nearly
- * uniform blocks: 4.9 ms vs 0.37 ms per transition), so rings keep the earlier 100. */
+ * uniform blocks: 4.9 ms vs 0.37 ms per transition), so rings keep the earlier 100; so do
+ * lattices, whose clusters are never tridiagonal either. */
 #define AUTO_EXACT_MAX_BLOCKS 1000
 #define AUTO_EXACT_MAX_RING 100
 #define STIFF_RATIO 50.0
@@ -58,13 +59,15 @@ double bk_stiffness_ratio(const bk_model *model)
         return NAN;
     /* Every block slipping: one island, the whole chain. */
     size_t n = model->n_blocks, n_max = bk_island_max_y(&probe, n);
-    bk_island island = {.scene = &probe, .id = 0, .start = 0, .len = n};
+    bk_island island = {.scene = &probe, .id = 0, .len = n};
     double *y = calloc(n_max, sizeof *y);
     double *diagonal = calloc(n_max, sizeof *diagonal);
     double *omega2 = calloc(n, sizeof *omega2);
     size_t *velocity_row_block = malloc(n_max * sizeof *velocity_row_block);
     double ratio = NAN;
     if (y && diagonal && omega2 && velocity_row_block && bk_island_reserve(&island, n) == 0) {
+        for (size_t i = 0; i < n; ++i)
+            island.blocks[i] = i;
         double speed = fabs(model->driver.velocity); /* a history's first non-zero speed */
         for (size_t i = 0; i < n; ++i) {
             probe.mode[i] = BK_MODE_SLIP_POS;
@@ -98,7 +101,9 @@ const char *bk_choose_method(const bk_config *config, const bk_scene *scene)
 {
     if (strcmp(config->solver.method, "auto") != 0)
         return config->solver.method;
-    size_t exact_max = config->model->boundary == BK_BOUNDARY_PERIODIC ? AUTO_EXACT_MAX_RING : AUTO_EXACT_MAX_BLOCKS;
+    const bk_model *m = config->model;
+    int dense_clusters = m->boundary_cols == BK_BOUNDARY_PERIODIC || bk_model_directions(m) > 2;
+    size_t exact_max = dense_clusters ? AUTO_EXACT_MAX_RING : AUTO_EXACT_MAX_BLOCKS;
     if (scene->affine && scene->n <= exact_max)
         return "exact";
     double ratio = bk_stiffness_ratio(config->model);

@@ -17,6 +17,8 @@ bk_model *bk_model_create(size_t n_blocks)
         return NULL;
     }
     model->n_blocks = n_blocks;
+    model->rows = 1;
+    model->cols = n_blocks;
     return model;
 }
 
@@ -47,25 +49,44 @@ double bk_model_driver_force(const bk_model *model, size_t i, double x_i, double
     return model->blocks[i].driver_stiffness * extension;
 }
 
-void bk_model_neighbours(const bk_model *model, size_t i, long *left, long *right)
+size_t bk_model_directions(const bk_model *model)
 {
-    size_t n = model->n_blocks;
-    long wall_or_none = model->boundary == BK_BOUNDARY_FIXED ? -2 : -1;
-    *left = i > 0 ? (long)i - 1 : wall_or_none;
-    *right = i + 1 < n ? (long)i + 1 : wall_or_none;
-    if (model->boundary == BK_BOUNDARY_PERIODIC && n > 1) {
-        if (i == 0)
-            *left = (long)n - 1;
-        if (i + 1 == n)
-            *right = 0;
+    /* A single row has partners up and down only between fixed walls. */
+    return model->rows > 1 || model->boundary_rows == BK_BOUNDARY_FIXED ? 4 : 2;
+}
+
+/* The partners before and after position p along a direction of length len. */
+static void along(bk_boundary boundary, size_t p, size_t len, long stride, long i, long *before, long *after)
+{
+    long wall_or_none = boundary == BK_BOUNDARY_FIXED ? -2 : -1;
+    *before = p > 0 ? i - stride : wall_or_none;
+    *after = p + 1 < len ? i + stride : wall_or_none;
+    if (boundary == BK_BOUNDARY_PERIODIC && len > 1) {
+        if (p == 0)
+            *before = i + (long)(len - 1) * stride;
+        if (p + 1 == len)
+            *after = i - (long)(len - 1) * stride;
     }
+}
+
+void bk_model_neighbours(const bk_model *model, size_t i, long partners[BK_MAX_NEIGHBOURS])
+{
+    size_t row = i / model->cols, col = i % model->cols;
+    along(model->boundary_cols, col, model->cols, 1, (long)i, &partners[BK_LEFT], &partners[BK_RIGHT]);
+    partners[BK_UP] = partners[BK_DOWN] = -1;
+    if (bk_model_directions(model) > 2)
+        along(model->boundary_rows, row, model->rows, (long)model->cols, (long)i, &partners[BK_UP],
+              &partners[BK_DOWN]);
 }
 
 int bk_model_coupling_count(const bk_model *model, size_t i)
 {
-    long left, right;
-    bk_model_neighbours(model, i, &left, &right);
-    return (left != -1) + (right != -1);
+    long partners[BK_MAX_NEIGHBOURS];
+    bk_model_neighbours(model, i, partners);
+    int count = 0;
+    for (size_t d = 0; d < BK_MAX_NEIGHBOURS; ++d)
+        count += partners[d] != -1;
+    return count;
 }
 
 double bk_model_block_stiffness(const bk_model *model, size_t i)
@@ -78,13 +99,12 @@ double bk_model_coupling_force(const bk_model *model, size_t i, const double *x)
     double kc = model->coupling_stiffness;
     if (kc == 0.0)
         return 0.0;
-    long left, right;
-    bk_model_neighbours(model, i, &left, &right);
+    long partners[BK_MAX_NEIGHBOURS];
+    bk_model_neighbours(model, i, partners);
     double force = 0.0;
-    if (left != -1)
-        force += kc * ((left >= 0 ? x[left] : 0.0) - x[i]);
-    if (right != -1)
-        force += kc * ((right >= 0 ? x[right] : 0.0) - x[i]);
+    for (size_t d = 0; d < BK_MAX_NEIGHBOURS; ++d)
+        if (partners[d] != -1)
+            force += kc * ((partners[d] >= 0 ? x[partners[d]] : 0.0) - x[i]);
     return force;
 }
 
@@ -99,20 +119,21 @@ double bk_model_damping_force(const bk_model *model, size_t i, const double *v)
     double etac = model->coupling_damping;
     if (etac == 0.0)
         return force;
-    long left, right;
-    bk_model_neighbours(model, i, &left, &right);
-    if (left != -1)
-        force += etac * ((left >= 0 ? v[left] : 0.0) - v[i]);
-    if (right != -1)
-        force += etac * ((right >= 0 ? v[right] : 0.0) - v[i]);
+    long partners[BK_MAX_NEIGHBOURS];
+    bk_model_neighbours(model, i, partners);
+    for (size_t d = 0; d < BK_MAX_NEIGHBOURS; ++d)
+        if (partners[d] != -1)
+            force += etac * ((partners[d] >= 0 ? v[partners[d]] : 0.0) - v[i]);
     return force;
 }
 
 int bk_model_is_damped(const bk_model *model)
 {
     /* Coupling dashpots exist where coupling springs do: between blocks, or to fixed walls. */
-    if (model->coupling_damping > 0.0 && (model->n_blocks > 1 || model->boundary == BK_BOUNDARY_FIXED))
-        return 1;
+    if (model->coupling_damping > 0.0)
+        for (size_t i = 0; i < model->n_blocks; ++i)
+            if (bk_model_coupling_count(model, i) > 0)
+                return 1;
     for (size_t i = 0; i < model->n_blocks; ++i)
         if (model->blocks[i].damping > 0.0)
             return 1;
@@ -131,18 +152,21 @@ double bk_model_elastic_energy(const bk_model *model, const double *x, double dr
     }
     if (kc == 0.0)
         return energy;
-    /* Each spring once: the one to the right of every block, plus the left wall. */
+    /* Each spring once: the ones right of and below every block, plus walls left and above. */
     for (size_t i = 0; i < n; ++i) {
-        long left, right;
-        bk_model_neighbours(model, i, &left, &right);
-        if (right >= 0) {
-            double d = x[right] - x[i];
-            energy += 0.5 * kc * d * d;
-        } else if (right == -2) {
-            energy += 0.5 * kc * x[i] * x[i];
+        long partners[BK_MAX_NEIGHBOURS];
+        bk_model_neighbours(model, i, partners);
+        static const size_t order[] = {BK_RIGHT, BK_LEFT, BK_DOWN, BK_UP};
+        for (size_t k = 0; k < BK_MAX_NEIGHBOURS; ++k) {
+            long j = partners[order[k]];
+            int after = order[k] == BK_RIGHT || order[k] == BK_DOWN;
+            if (after && j >= 0) {
+                double gap = x[j] - x[i];
+                energy += 0.5 * kc * gap * gap;
+            } else if (j == -2) {
+                energy += 0.5 * kc * x[i] * x[i];
+            }
         }
-        if (left == -2)
-            energy += 0.5 * kc * x[i] * x[i];
     }
     return energy;
 }

@@ -41,8 +41,10 @@ int bk_run_catalog_init(run_ctx *ctx, const bk_checkpoint *from)
         return BK_OK; /* a checkpoint from before catalogs: the resumed run writes none */
     bk_scene *scene = &ctx->scene;
     size_t n = scene->n;
-    ctx->catalog = bk_catalog_create(n, ctx->model->boundary == BK_BOUNDARY_PERIODIC,
-                                     config->catalog.magnitude_offset);
+    const bk_model *m = ctx->model;
+    ctx->catalog = bk_catalog_create_lattice(m->rows, m->cols, m->boundary_rows == BK_BOUNDARY_PERIODIC,
+                                             m->boundary_cols == BK_BOUNDARY_PERIODIC,
+                                             config->catalog.magnitude_offset);
     ctx->rate_v = malloc(n * sizeof *ctx->rate_v);
     ctx->rate_a = malloc(n * sizeof *ctx->rate_a);
     int creeping = 0;
@@ -162,9 +164,10 @@ int bk_run_catalog_finish(run_ctx *ctx, double t)
         return BK_OK;
     bk_event event;
     ctx->t_catalog = t;
-    if (bk_catalog_finish(ctx->catalog, t, ctx->scene.x, applied_force, ctx, &event) == 1)
-        return emit(ctx, &event);
-    return BK_OK;
+    int rc = bk_catalog_finish(ctx->catalog, t, ctx->scene.x, applied_force, ctx, &event);
+    if (rc < 0)
+        return BK_FAIL(ctx->err, rc, "out of memory closing the last event at t = %.17g s", t);
+    return rc == 1 ? emit(ctx, &event) : BK_OK;
 }
 
 bk_catalog_state *bk_run_catalog_save(run_ctx *ctx)

@@ -5,6 +5,7 @@
 #define BKSIM_RUN_IMPL_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include <gsl/gsl_roots.h>
 
@@ -71,6 +72,13 @@ typedef struct run_ctx {
     bk_heap quiet;
     gsl_root_fsolver *brent; /* hidden stops and aging breakaways, one at a time */
     size_t *batch;           /* blocks failing at one instant, scratch */
+    /* The partition's scratch (run_partition.c): the region rebuilt, as a sparse set of
+     * blocks, a component's blocks, and the lines (rows or columns) an island occupies. */
+    size_t *region, *region_pos, n_region;
+    size_t *members;
+    uint8_t *visited;        /* by region position */
+    size_t *lines;           /* max(rows, cols) */
+    uint8_t *line_seen;      /* max(rows, cols), zero between uses */
 
     /* Energy bookkeeping: what finished, and each stuck block's driver-spring energy when its
      * stuck interval began (the driver's work on a stuck block is that spring's gain). */
@@ -161,9 +169,11 @@ const double *bk_run_probe_state(bk_block_probe *probe, double t);
 /* ---- run_islands.c ---- */
 int bk_run_islands_init(run_ctx *ctx);
 void bk_run_islands_free(run_ctx *ctx);
-/* Dissolve every island and rebuild the whole partition at t (the chain's arrays hold the
- * state there): at the start, at checkpoints and on resuming. */
-int bk_run_partition_all(run_ctx *ctx, double t);
+/* Dissolve island id at t: its state into the chain (unless `taken`: already there) and its
+ * energy increments into the closed totals. */
+int bk_run_dissolve(run_ctx *ctx, size_t id, double t, int taken);
+/* A new island over these blocks (in the island's order), started at t. */
+int bk_run_found_island(run_ctx *ctx, const size_t *blocks, size_t len, double t);
 /* One step of island id; records the event it finds (pending). */
 int bk_run_island_step(run_ctx *ctx, size_t id);
 /* Apply the machine to block i at t (the chain's arrays unpacked there): the transition and
@@ -181,6 +191,17 @@ void bk_run_make_quiet(run_ctx *ctx, size_t i, double t);
 int bk_run_unpack_all(run_ctx *ctx, double t);
 /* Counters of every back-end instance so far. */
 void bk_run_solver_counters(const run_ctx *ctx, bk_solver_counters *total);
+
+/* ---- run_partition.c ---- */
+int bk_run_partition_init(run_ctx *ctx);
+void bk_run_partition_free(run_ctx *ctx);
+/* Dissolve every island and rebuild the whole partition at t (the chain's arrays hold the
+ * state there): at the start, at checkpoints and on resuming. */
+int bk_run_partition_all(run_ctx *ctx, double t);
+/* Rebuild the partition at t around the seed blocks, whose modes changed: they, their
+ * partners and every island those touch (dissolved at t; `taken`: the one whose increments
+ * were already taken, or BK_NO_ISLAND). */
+int bk_run_repartition(run_ctx *ctx, const size_t *seeds, size_t n_seeds, double t, size_t taken);
 
 /* ---- run_catalog.c ---- */
 /* The builder, begun at t = 0 from the chain's arrays or restored from a checkpoint (none

@@ -1,13 +1,13 @@
-/* The chain's partition into islands and quiet blocks (scene.h), and what happens to them:
- * an island steps with its own integrator and finds its next event; at an event only that
- * island (and a neighbour it may merge with) is rebuilt; a quiet block breaks away at a time
- * known in closed form (run_quiet.c), kept in a priority queue.  Nothing here loops over the chain except
- * bk_run_partition_all (start, checkpoints) and bk_run_unpack_all (output rows).
+/* The islands and quiet blocks of the partition (scene.h; run_partition.c builds it), and
+ * what happens to them: an island steps with its own integrator and finds its next event;
+ * at an event only that island (and a neighbour it may merge with) is rebuilt; a quiet
+ * block breaks away at a time known in closed form (run_quiet.c), kept in a priority queue.
+ * Nothing here loops over the chain except bk_run_unpack_all (output rows).
  *
  * Why the partition is safe: a quiet block's neighbours are stuck, so its applied force is
  * affine in the driver's position until one of them moves, which only happens through an
  * event that rebuilds the partition around it (and recomputes its failure time).  An island
- * depends on blocks outside it only through stuck ends, so islands integrated to different
+ * depends on blocks outside it only through stuck ones, so islands integrated to different
  * times never see each other: the scheduler (run.c) always handles the earliest pending
  * event first, and every island's last step then contains that time, so its state there is
  * at hand (dense output) when a merge needs it. */
@@ -48,7 +48,7 @@ int bk_run_islands_init(run_ctx *ctx)
         ctx->idle_budget = 16 * POOL_LARGEST_Y;
     ctx->batch = malloc(n * sizeof *ctx->batch);
     ctx->brent = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
-    return ctx->batch && ctx->brent ? 0 : -1;
+    return ctx->batch && ctx->brent && bk_run_partition_init(ctx) == 0 ? 0 : -1;
 }
 
 void bk_run_islands_free(run_ctx *ctx)
@@ -70,6 +70,7 @@ void bk_run_islands_free(run_ctx *ctx)
     free(ctx->islands);
     free(ctx->free_ids);
     free(ctx->batch);
+    bk_run_partition_free(ctx);
     if (ctx->brent)
         gsl_root_fsolver_free(ctx->brent);
     bk_heap_free(&ctx->quiet);
@@ -324,21 +325,7 @@ int bk_run_unpack_all(run_ctx *ctx, double t)
 
 /* --------------------------------------------------------------- the partition --- */
 
-static size_t wrap(const run_ctx *ctx, long j)
-{
-    long n = (long)ctx->scene.n;
-    long i = j % n;
-    return (size_t)(i < 0 ? i + n : i);
-}
-
-static int periodic(const run_ctx *ctx)
-{
-    return ctx->model->boundary == BK_BOUNDARY_PERIODIC;
-}
-
-/* Dissolve island id at t: its state into the chain (unless already there) and its energy
- * increments into the closed totals. */
-static int dissolve(run_ctx *ctx, size_t id, double t, int taken)
+int bk_run_dissolve(run_ctx *ctx, size_t id, double t, int taken)
 {
     run_island *isl = ctx->islands[id];
     if (!taken) {
@@ -358,135 +345,18 @@ static int dissolve(run_ctx *ctx, size_t id, double t, int taken)
     return BK_OK;
 }
 
-/* A new island over chain positions [lo, hi] (unwrapped), started at t. */
-static int found_island(run_ctx *ctx, long lo, long hi, double t)
+int bk_run_found_island(run_ctx *ctx, const size_t *blocks, size_t len, double t)
 {
     size_t id = BK_NO_ISLAND;
-    int rc = new_island(ctx, bk_island_y_length(&ctx->scene, wrap(ctx, lo), (size_t)(hi - lo + 1)), &id);
+    int rc = new_island(ctx, bk_island_y_length(&ctx->scene, blocks, len), &id);
     if (rc != BK_OK)
         return rc;
-    bk_island *island = &ctx->islands[id]->island;
-    island->start = wrap(ctx, lo);
-    island->len = (size_t)(hi - lo + 1);
-    if (island->len > ctx->scene.n)
-        return BK_FAIL(ctx->err, BK_ERR_INTERNAL, "an island of %zu blocks on a chain of %zu at t = %.17g s",
-                       island->len, ctx->scene.n, t);
+    run_island *isl = ctx->islands[id];
+    if ((rc = reserve_vectors(ctx, isl, len)) != BK_OK)
+        return rc;
+    memcpy(isl->island.blocks, blocks, len * sizeof *blocks);
+    isl->island.len = len;
     return start_island(ctx, id, t);
-}
-
-/* The slipping runs [group_lo, group_hi] become one island with the stuck blocks around
- * them (clipped at a free chain's ends); the blocks from *next_quiet up to it go quiet. */
-static int close_group(run_ctx *ctx, long group_lo, long group_hi, long *next_quiet, double t)
-{
-    long n = (long)ctx->scene.n, a = group_lo - 1, b = group_hi + 1;
-    if (!periodic(ctx)) {
-        a = a < 0 ? 0 : a;
-        b = b > n - 1 ? n - 1 : b;
-    }
-    for (long q = *next_quiet; q < a; ++q)
-        bk_run_make_quiet(ctx, wrap(ctx, q), t);
-    *next_quiet = b + 1;
-    return found_island(ctx, a, b, t);
-}
-
-/* Rebuild islands and quiet blocks over chain positions [lo, hi] (unwrapped; every block
- * there belongs to no island, and the blocks at both ends are stuck unless they are chain
- * ends), or over the whole ring.  Slipping runs that one stuck block separates form one
- * island with the stuck blocks around them. */
-static int rebuild(run_ctx *ctx, long lo, long hi, int whole_ring, double t)
-{
-    const bk_scene *scene = &ctx->scene;
-    long n = (long)scene->n;
-    if (whole_ring) {
-        /* Start the scan where two stuck blocks meet: no island crosses there.  Without such
-         * a place every stuck block sits between slipping ones: one island, the ring. */
-        long cut = -1;
-        for (long j = 0; j < n && cut < 0; ++j)
-            if (bk_scene_stuck(scene, wrap(ctx, j)) && bk_scene_stuck(scene, wrap(ctx, j - 1)))
-                cut = j;
-        if (cut < 0) {
-            int any_slipping = 0;
-            for (long j = 0; j < n && !any_slipping; ++j)
-                any_slipping = !bk_scene_stuck(scene, (size_t)j);
-            if (any_slipping)
-                return found_island(ctx, 0, n - 1, t);
-            for (long j = 0; j < n; ++j)
-                bk_run_make_quiet(ctx, (size_t)j, t);
-            return BK_OK;
-        }
-        lo = cut;
-        hi = cut + n - 1;
-    }
-    long group_lo = 0, group_hi = -2, next_quiet = lo; /* no group open: group_hi < group_lo */
-    int rc = BK_OK;
-    for (long j = lo; j <= hi && rc == BK_OK; ++j) {
-        if (bk_scene_stuck(scene, wrap(ctx, j)))
-            continue;
-        long run_lo = j;
-        while (j + 1 <= hi && !bk_scene_stuck(scene, wrap(ctx, j + 1)))
-            ++j;
-        if (group_hi >= group_lo && run_lo - group_hi == 2) {
-            group_hi = j; /* one stuck block between: the same island */
-            continue;
-        }
-        if (group_hi >= group_lo)
-            rc = close_group(ctx, group_lo, group_hi, &next_quiet, t);
-        group_lo = run_lo;
-        group_hi = j;
-    }
-    if (rc == BK_OK && group_hi >= group_lo)
-        rc = close_group(ctx, group_lo, group_hi, &next_quiet, t);
-    for (long q = next_quiet; rc == BK_OK && q <= hi; ++q)
-        bk_run_make_quiet(ctx, wrap(ctx, q), t);
-    return rc;
-}
-
-/* Rebuild the partition around chain positions [lo, hi] (unwrapped) at t, after modes there
- * changed: the range grows by one block each way and by every island it touches (dissolved
- * at t; the one whose increments were already taken is `taken`). */
-static int repartition(run_ctx *ctx, long lo, long hi, double t, size_t taken)
-{
-    bk_scene *scene = &ctx->scene;
-    long n = (long)scene->n;
-    lo -= 1;
-    hi += 1;
-    if (!periodic(ctx)) {
-        lo = lo < 0 ? 0 : lo;
-        hi = hi > n - 1 ? n - 1 : hi;
-    }
-    int rc = BK_OK;
-    /* On a ring the range may come round to cover it all: then everything is rebuilt. */
-    for (long j = lo; j <= hi && (!periodic(ctx) || hi - lo + 1 < n); ++j) {
-        size_t id = scene->island_of[wrap(ctx, j)];
-        if (id == BK_NO_ISLAND)
-            continue;
-        const bk_island *island = &ctx->islands[id]->island;
-        long offset = (long)wrap(ctx, (long)wrap(ctx, j) - (long)island->start);
-        long first = j - offset, last = first + (long)island->len - 1;
-        if ((rc = dissolve(ctx, id, t, id == taken)) != BK_OK)
-            return rc;
-        lo = first < lo ? first : lo;
-        hi = last > hi ? last : hi;
-    }
-    int whole_ring = periodic(ctx) && hi - lo + 1 >= n;
-    if (whole_ring)
-        for (size_t id = 0; id < ctx->islands_used && rc == BK_OK; ++id)
-            if (ctx->islands[id]->live)
-                rc = dissolve(ctx, id, t, id == taken);
-    return rc == BK_OK ? rebuild(ctx, lo, hi, whole_ring, t) : rc;
-}
-
-int bk_run_partition_all(run_ctx *ctx, double t)
-{
-    for (size_t id = 0; id < ctx->islands_used; ++id)
-        if (ctx->islands[id]->live) {
-            int rc = dissolve(ctx, id, t, 1);
-            if (rc != BK_OK)
-                return rc;
-        }
-    bk_heap_clear(&ctx->quiet);
-    long n = (long)ctx->scene.n;
-    return rebuild(ctx, 0, n - 1, periodic(ctx), t);
 }
 
 /* ------------------------------------------------------------- island events --- */
@@ -700,8 +570,7 @@ int bk_run_island_event(run_ctx *ctx, size_t id)
         ctx->t_row_due = t;
     if (!changed)
         return start_island(ctx, id, t);
-    long lo = (long)island->start;
-    return repartition(ctx, lo, lo + (long)island->len - 1, t, id);
+    return bk_run_repartition(ctx, island->blocks, island->len, t, id);
 }
 
 static int by_block(const void *a, const void *b)
@@ -743,33 +612,5 @@ int bk_run_quiet_failures(run_ctx *ctx, double t)
     ctx->stats->stuck_jumps++;
     if (count > 0 && ctx->event_rows)
         ctx->t_row_due = t;
-    /* One repartition per run of neighbouring failures, so that every range rebuilt ends
-     * on blocks that did not fail.  On a ring a run may pass from block n - 1 to block 0:
-     * the scan then starts where that run does, its first blocks counted below 0. */
-    long n = (long)scene->n;
-    size_t first = 0;
-    if (periodic(ctx) && count > 0 && (long)count < n && ctx->batch[0] == 0 &&
-        (long)ctx->batch[count - 1] == n - 1) {
-        first = count - 1;
-        while (first > 0 && ctx->batch[first - 1] + 1 == ctx->batch[first])
-            --first;
-    }
-    long lo = 0, prev = 0;
-    for (size_t m = 0; m < count; ++m) {
-        size_t idx = (first + m) % count;
-        long j = (long)ctx->batch[idx] - (first > 0 && idx >= first ? n : 0);
-        if (m > 0 && j == prev + 1) {
-            prev = j;
-            continue;
-        }
-        if (m > 0) {
-            int rc = repartition(ctx, lo, prev, t, BK_NO_ISLAND);
-            if (rc != BK_OK)
-                return rc;
-        }
-        lo = prev = j;
-    }
-    if (count > 0)
-        return repartition(ctx, lo, prev, t, BK_NO_ISLAND);
-    return BK_OK;
+    return count > 0 ? bk_run_repartition(ctx, ctx->batch, count, t, BK_NO_ISLAND) : BK_OK;
 }

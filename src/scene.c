@@ -31,12 +31,12 @@ int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
     scene->slot = malloc(n * sizeof *scene->slot);
     scene->state_slot = malloc(n * sizeof *scene->state_slot);
     scene->island_of = malloc(n * sizeof *scene->island_of);
-    scene->left = calloc(n, sizeof *scene->left);
-    scene->right = calloc(n, sizeof *scene->right);
+    scene->n_directions = bk_model_directions(model);
+    scene->partner = malloc(n * scene->n_directions * sizeof *scene->partner);
     if (!scene->mode || !scene->x_ref || !scene->x || !scene->v || !scene->state ||
         !scene->state_time || !scene->normal || !scene->t_switch || !scene->from_rest ||
         !scene->taut || !scene->can_stick || !scene->extremum_armed || !scene->slot ||
-        !scene->state_slot || !scene->island_of || !scene->left || !scene->right) {
+        !scene->state_slot || !scene->island_of || !scene->partner) {
         bk_scene_free(scene);
         return -1;
     }
@@ -54,7 +54,9 @@ int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
         scene->slot[i] = scene->state_slot[i] = BK_NO_SLOT;
         scene->island_of[i] = BK_NO_ISLAND;
         scene->taut[i] = 1;
-        bk_model_neighbours(model, i, &scene->left[i], &scene->right[i]);
+        long partners[BK_MAX_NEIGHBOURS];
+        bk_model_neighbours(model, i, partners);
+        memcpy(&scene->partner[i * scene->n_directions], partners, scene->n_directions * sizeof *partners);
         if (b->law->n_state > 0)
             b->law->state_init(b->friction_params, &scene->state[b->state_offset]);
         if (b->law->n_state > scene->max_block_state)
@@ -80,8 +82,7 @@ void bk_scene_free(bk_scene *scene)
     free(scene->slot);
     free(scene->state_slot);
     free(scene->island_of);
-    free(scene->left);
-    free(scene->right);
+    free(scene->partner);
     memset(scene, 0, sizeof *scene);
 }
 

@@ -1,14 +1,16 @@
-/* Internal: the chain's state during a run, and the islands the integrator sees.
+/* Internal: the chain's (or lattice's) state during a run, and the islands the integrator
+ * sees.
  *
- * Stuck blocks split the slipping ones into independent groups.  An island is a contiguous
- * run of blocks (cyclic on a periodic chain): slipping stretches that only one stuck block
- * separates, together with the stuck blocks next to them.  A stuck block's breakaway then
+ * Stuck blocks split the slipping ones into independent groups.  An island is a connected
+ * component of the slipping blocks and their neighbours, joined only through slipping
+ * blocks: on a chain a run of blocks (cyclic on a ring), slipping stretches that only one
+ * stuck block separates, together with the stuck blocks next to them.  A stuck block's breakaway then
  * depends on one island only, and a stuck block next to no slipping block ("quiet") on
  * nothing that moves: its failure time follows in closed form from the driver's motion and
  * needs no integrator at all.  Each island is integrated on its own, so the work of a step
  * or an event is proportional to the island, not to the chain.
  *
- * An island's integrated vector is, in chain order, per block: [xi, v] if slipping (xi =
+ * An island's integrated vector is, in the island's block order, per block: [xi, v] if slipping (xi =
  * x - x_ref, the slip since the island's restart, so the integrator's error scales with the
  * slip, not the absolute position), then the block's friction state if its law has any; and
  * last the energy increments since the restart: the driver work on its slipping blocks, their
@@ -69,7 +71,8 @@ typedef struct bk_scene {
     size_t *slot;            /* per block: index of xi in its island's y, or BK_NO_SLOT */
     size_t *state_slot;      /* per block: index of its first friction state in its island's y */
     size_t *island_of;       /* per block: its island, or BK_NO_ISLAND (quiet) */
-    long *left, *right;      /* coupling partners (bk_model_neighbours) */
+    long *partner;           /* coupling partners (bk_model_neighbours), n_directions per block */
+    size_t n_directions;     /* bk_model_directions: 2 on a chain, 4 on a lattice */
     size_t roots_per_block;  /* 2, or 3 with tension-only springs */
     size_t max_block_state;  /* friction states of the most stateful block */
     double slip_threshold;   /* m/s: the event catalog's slip rate for laws without a stuck
@@ -84,6 +87,21 @@ void bk_scene_free(bk_scene *scene);
 static inline int bk_scene_stuck(const bk_scene *scene, size_t i)
 {
     return scene->mode[i] == BK_MODE_STICK;
+}
+
+/* Block i's coupling partners, scene->n_directions of them (bk_model_neighbours). */
+static inline const long *bk_scene_partners(const bk_scene *scene, size_t i)
+{
+    return &scene->partner[i * scene->n_directions];
+}
+/* Neighbours block i is coupled to, walls included (bk_model_coupling_count). */
+static inline int bk_scene_coupling_count(const bk_scene *scene, size_t i)
+{
+    const long *partner = bk_scene_partners(scene, i);
+    int count = 0;
+    for (size_t d = 0; d < scene->n_directions; ++d)
+        count += partner[d] != -1;
+    return count;
 }
 
 /* Applied force on block i, springs and dashpots, with the unpacked positions and velocities at
@@ -119,11 +137,13 @@ static inline void bk_energy_add(bk_energy *sum, const bk_energy *more)
     sum->damping += more->damping;
 }
 
-/* An island: blocks start, start + 1, ..., start + len - 1 of the chain (mod n). */
+/* An island: len blocks, listed in the partition's order (run_islands.c: a chain's run from
+ * its first block, a lattice's blocks row by row), so that coupled blocks sit close in y. */
 typedef struct bk_island {
     bk_scene *scene;
     size_t id;               /* index in the run's island table */
-    size_t start, len;
+    size_t *blocks;          /* its len blocks */
+    size_t len;
     /* Layout, rebuilt at every restart. */
     size_t n_y;              /* length of y */
     size_t n_active;         /* slipping blocks */
@@ -143,19 +163,19 @@ typedef struct bk_island {
 
 static inline size_t bk_island_block(const bk_island *island, size_t k)
 {
-    size_t i = island->start + k;
-    return i < island->scene->n ? i : i - island->scene->n;
+    return island->blocks[k];
 }
 static inline size_t bk_island_n_roots(const bk_island *island)
 {
     return island->scene->roots_per_block * island->len;
 }
-/* The length of y an island over blocks start .. start + len - 1 gets for their current modes. */
-size_t bk_island_y_length(const bk_scene *scene, size_t start, size_t len);
+/* The length of y an island over these len blocks gets for their current modes. */
+size_t bk_island_y_length(const bk_scene *scene, const size_t *blocks, size_t len);
 /* Longest y an island of len blocks can need. */
 size_t bk_island_max_y(const bk_scene *scene, size_t len);
 
-/* Room for an island of len blocks (arrays grow, never shrink); -1 when out of memory. */
+/* Room for an island of len blocks (arrays grow, never shrink, and the block list does not
+ * survive a growth); -1 when out of memory. */
 int bk_island_reserve(bk_island *island, size_t len);
 void bk_island_free(bk_island *island);
 /* Rebuild the layout for the current modes at time t (x, v and state of the island's blocks

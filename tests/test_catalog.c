@@ -118,6 +118,40 @@ static void test_ring_extent(void **state)
     bk_catalog_free(c);
 }
 
+/* On a lattice the extent is the bounding box, left its top-left corner block and right its
+ * bottom-right one; a periodic direction takes its shorter arc, as a ring does. */
+static void test_lattice_extent(void **state)
+{
+    (void)state;
+    /* 4 rows x 5 columns, periodic columns: block = 5 row + column. */
+    bk_catalog *c = bk_catalog_create_lattice(4, 5, 0, 1, 0.0);
+    const bk_transition list[] = {
+        /* (1, 1), (2, 3), (3, 2): rows 1..3, columns 1..3 */
+        tr(1.0, 6, STICK, SLIP, 0.0, 1.0), tr(1.1, 13, STICK, SLIP, 0.0, 1.0),
+        tr(1.2, 17, STICK, SLIP, 0.0, 1.0), tr(1.3, 6, SLIP, STICK, 0.1, 0.0),
+        tr(1.3, 13, SLIP, STICK, 0.1, 0.0), tr(1.3, 17, SLIP, STICK, 0.1, 0.0),
+        /* (0, 4), (0, 0), (1, 0): row 0..1, columns 4 round to 0 */
+        tr(2.0, 4, STICK, SLIP, 0.0, 1.0), tr(2.1, 0, STICK, SLIP, 0.0, 1.0),
+        tr(2.1, 5, STICK, SLIP, 0.0, 1.0), tr(2.2, 4, SLIP, STICK, 0.1, 0.0),
+        tr(2.2, 0, SLIP, STICK, 0.1, 0.0), tr(2.2, 5, SLIP, STICK, 0.1, 0.0),
+        tr(3.0, 12, STICK, SLIP, 0.0, 1.0),
+    };
+    bk_event e[3];
+    assert_int_equal(feed(c, list, sizeof list / sizeof *list, e), 2);
+    assert_int_equal(e[0].n_blocks, 3);
+    assert_int_equal(e[0].left, 1 * 5 + 1);
+    assert_int_equal(e[0].right, 3 * 5 + 3);
+    assert_int_equal(e[1].left, 0 * 5 + 4); /* columns wrap: left's column 4 > right's 0 */
+    assert_int_equal(e[1].right, 1 * 5 + 0);
+    bk_catalog_free(c);
+    /* Without periodic columns the same blocks span columns 0..4. */
+    c = bk_catalog_create_lattice(4, 5, 0, 0, 0.0);
+    assert_int_equal(feed(c, list, sizeof list / sizeof *list, e), 2);
+    assert_int_equal(e[1].left, 0);
+    assert_int_equal(e[1].right, 1 * 5 + 4);
+    bk_catalog_free(c);
+}
+
 /* Blocks slipping at the start open an event; one still running at the end of the run is
  * returned marked incomplete, its open episodes counted to the end; a pending end is
  * completed by the finish. */
@@ -172,6 +206,7 @@ int main(void)
         cmocka_unit_test(test_one_event),
         cmocka_unit_test(test_overlap_and_instants),
         cmocka_unit_test(test_ring_extent),
+        cmocka_unit_test(test_lattice_extent),
         cmocka_unit_test(test_begin_and_finish),
         cmocka_unit_test(test_bad_block),
     };

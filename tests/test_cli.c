@@ -187,6 +187,38 @@ typedef struct bad_case {
     const char *expect; /* substring of the message */
 } bad_case;
 
+/* A chain as a 1 x N lattice, and as an N x 1 one (coupled up and down instead of left and
+ * right), writes the chain's output bit for bit: free ends (bk10_coulomb), fixed walls, and
+ * a ring with a system-size event at 91 s (carlson_langer_100). */
+static void test_lattice_of_one_line_is_a_chain(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *config, *extra, *boundary;
+    } chains[] = {
+        {"configs/chains/bk10_coulomb.ini", "--set run.t_end=4", "free"},
+        {"configs/chains/bk10_coulomb.ini", "--set run.t_end=4 --set model.boundary=fixed", "fixed"},
+        {"configs/chains/carlson_langer_100.ini",
+         "--set run.t_end=120 --set output.transitions=true --set output.interval=0.5", "periodic"},
+    };
+    char chain[600], lattice[600], cmd[2048];
+    for (size_t k = 0; k < sizeof chains / sizeof chains[0]; ++k) {
+        snprintf(chain, sizeof chain, "%s/line_chain.h5", tmpdir);
+        snprintf(cmd, sizeof cmd, "./bksim run %s %s -o %s --quiet --force", chains[k].config, chains[k].extra, chain);
+        assert_int_equal(run_command(cmd, NULL), 0);
+        for (int column = 0; column < 2; ++column) {
+            snprintf(lattice, sizeof lattice, "%s/line_lattice.h5", tmpdir);
+            /* n_blocks stays as the chain gives it: the other dimension follows. */
+            snprintf(cmd, sizeof cmd, "./bksim run %s %s --set model.%s=1 --set model.boundary_rows=%s "
+                     "--set model.boundary_cols=%s -o %s --quiet --force", chains[k].config, chains[k].extra,
+                     column ? "cols" : "rows", column ? chains[k].boundary : "free",
+                     column ? "free" : chains[k].boundary, lattice);
+            assert_int_equal(run_command(cmd, NULL), 0);
+            assert_same_output(chain, lattice);
+        }
+    }
+}
+
 static void test_bad_inputs(void **state)
 {
     (void)state;
@@ -208,6 +240,13 @@ static void test_bad_inputs(void **state)
         {"mass = 1", "mass = 1\ndamping = -1", "bad.ini:5: [block] damping: out of range, got -1"},
         {"[model]", "[model]\ncoupling_damping = -3", "bad.ini:2: [model] coupling_damping: out of range, got -3"},
         {"mass = 1", "mass = 1\ndamping = normal(1, -0.5)", "bad.ini:5: [block] damping: normal(1, -0.5) has a negative width"},
+        {"n_blocks = 1", "n_blocks = 6\nrows = 2\ncols = 4", "bad.ini:2: [model] n_blocks: 6 blocks, but rows * cols = 2 * 4 = 8"},
+        {"n_blocks = 1", "n_blocks = 6\nrows = 4", "bad.ini:3: [model] rows: 4 does not divide n_blocks = 6"},
+        {"n_blocks = 1", "rows = 3", "bad.ini: [model] n_blocks: required key missing (allowed: 1 <= n_blocks"},
+        {"n_blocks = 1", "rows = 0\ncols = 4", "bad.ini:2: [model] rows: out of range, got 0"},
+        {"n_blocks = 1", "rows = 2\ncols = 2.5", "bad.ini:3: [model] cols:"},
+        {"n_blocks = 1", "rows = 2000\ncols = 2000", "bad.ini:3: [model] cols: rows * cols = 4000000 blocks (allowed: at most 1000000)"},
+        {"n_blocks = 1", "n_blocks = 4\nboundary_rows = twisted", "bad.ini:3: [model] boundary_rows:"},
     };
     char path[512], out[512], cmd[2048], cwd[1024];
     assert_non_null(getcwd(cwd, sizeof cwd));
@@ -1342,6 +1381,7 @@ int main(void)
         cmocka_unit_test(test_paper_configs),
         cmocka_unit_test(test_paper_rate_state),
         cmocka_unit_test(test_bad_inputs),
+        cmocka_unit_test(test_lattice_of_one_line_is_a_chain),
         cmocka_unit_test(test_every_key_rejects_bad_values),
         cmocka_unit_test(test_distribution_errors),
         cmocka_unit_test(test_commands),

@@ -126,7 +126,7 @@ static void test_full_config(void **state)
     assert_int_equal(bk_config_load_string(full_config, "full.ini", NULL, 0, &c, &err), BK_OK);
     const bk_model *m = c->model;
     assert_int_equal(m->n_blocks, 3);
-    assert_int_equal(m->boundary, BK_BOUNDARY_FIXED);
+    assert_int_equal(m->boundary_cols, BK_BOUNDARY_FIXED);
     assert_close(m->coupling_stiffness, 2.385e3, 0, 0);
     assert_close(m->gravity, 9.8, 0, 0);
     assert_close(m->blocks[0].mass, 1.5, 0, 0);
@@ -170,7 +170,7 @@ static void test_defaults(void **state)
     bk_config *c = NULL;
     bk_error err = {0};
     assert_int_equal(bk_config_load_string(minimal_config, "some/dir/case_q.ini", NULL, 0, &c, &err), BK_OK);
-    assert_int_equal(c->model->boundary, BK_BOUNDARY_FREE);
+    assert_int_equal(c->model->boundary_cols, BK_BOUNDARY_FREE);
     assert_int_equal(c->model->spring, BK_SPRING_LINEAR);
     assert_close(c->model->gravity, 9.81, 0, 0);
     assert_close(c->model->blocks[0].normal_force, 9.81, 0, 0);

@@ -31,8 +31,10 @@ static bk_model *make_chain(size_t n, bk_spring spring)
 /* An island over blocks [start, start + len) of the scene's chain. */
 static bk_island island_of(bk_scene *s, size_t id, size_t start, size_t len)
 {
-    bk_island island = {.scene = s, .id = id, .start = start, .len = len};
+    bk_island island = {.scene = s, .id = id, .len = len};
     assert_int_equal(bk_island_reserve(&island, len), 0);
+    for (size_t k = 0; k < len; ++k)
+        island.blocks[k] = (start + k) % s->n;
     return island;
 }
 
@@ -300,6 +302,10 @@ static void test_tension_only_frozen(void **state)
     bk_model_free(m);
 }
 
+enum { CHAIN, LATTICE_WALLS, TORUS };
+#define MAX_N 9
+#define MAX_Y (MAX_N * 3 + 3)
+
 typedef struct dense {
     size_t n;
     double *a;
@@ -315,7 +321,7 @@ static void put_dense(void *matrix, size_t row, size_t col, double value)
 static void evaluate(bk_island *island, int implicit_part, double t, const double *y, double *out)
 {
     if (implicit_part) {
-        double rest[16];
+        double rest[MAX_Y];
         assert_int_equal(bk_island_rhs_split(t, y, rest, out, island), 0);
     } else {
         assert_int_equal(bk_island_rhs(t, y, out, island), 0);
@@ -325,14 +331,22 @@ static void evaluate(bk_island *island, int implicit_part, double t, const doubl
 /* The analytic Jacobian matches central differences of the right-hand side, for a chain
  * mixing Coulomb and the paper's rate-and-state law, tension-only springs, a periodic
  * wrap, slipping and stuck blocks; in the compact and the full layout; and the same for
- * the friction part of the IMEX split, whose two parts add up to the right-hand side. */
-static void check_jacobian(int full_layout, int implicit_part, int damped)
+ * the friction part of the IMEX split, whose two parts add up to the right-hand side.  On
+ * a 3 x 3 lattice (walls above and below, or a torus) the same; with walls, every entry
+ * off the energy rows lies within the declared half bandwidth, a row apart. */
+static void check_jacobian(int full_layout, int implicit_part, int damped, int shape)
 {
-    bk_model *m = make_chain(4, BK_SPRING_TENSION_ONLY);
-    m->boundary = BK_BOUNDARY_PERIODIC;
+    size_t nb = shape == CHAIN ? 4 : 9;
+    bk_model *m = make_chain(nb, BK_SPRING_TENSION_ONLY);
+    m->boundary_cols = BK_BOUNDARY_PERIODIC;
+    if (shape != CHAIN) {
+        m->rows = m->cols = 3;
+        m->boundary_rows = shape == TORUS ? BK_BOUNDARY_PERIODIC : BK_BOUNDARY_FIXED;
+        m->boundary_cols = shape == TORUS ? BK_BOUNDARY_PERIODIC : BK_BOUNDARY_FREE;
+    }
     if (damped) {
         m->coupling_damping = 3.5;
-        for (size_t i = 0; i < 4; ++i)
+        for (size_t i = 0; i < nb; ++i)
             m->blocks[i].damping = 0.75 + 0.5 * (double)i;
     }
     m->blocks[1].law = &bk_friction_rate_state;
@@ -348,28 +362,31 @@ static void check_jacobian(int full_layout, int implicit_part, int damped)
     bk_scene s;
     assert_int_equal(bk_scene_init(&s, m, 1), 0);
     s.full_layout = full_layout;
-    const double x[4] = {1e-4, -2e-4, 3e-4, 0.5e-4}, v[4] = {3e-3, -2e-3, 0.0, 1e-3};
-    const int8_t modes[4] = {BK_MODE_SLIP_POS, BK_MODE_SLIP_NEG, BK_MODE_STICK, BK_MODE_SLIP_POS};
-    for (size_t i = 0; i < 4; ++i) {
+    const double x[MAX_N] = {1e-4, -2e-4, 3e-4, 0.5e-4, -1e-4, 2.5e-4, 0.2e-4, -0.7e-4, 1.3e-4};
+    const double v[MAX_N] = {3e-3, -2e-3, 0.0, 1e-3, 2e-3, 0.0, 4e-3, -1e-3, 1.5e-3};
+    const int8_t modes[MAX_N] = {BK_MODE_SLIP_POS, BK_MODE_SLIP_NEG, BK_MODE_STICK, BK_MODE_SLIP_POS,
+                                 BK_MODE_SLIP_POS, BK_MODE_STICK,    BK_MODE_SLIP_POS, BK_MODE_SLIP_NEG,
+                                 BK_MODE_SLIP_POS};
+    for (size_t i = 0; i < nb; ++i) {
         s.x[i] = x[i];
         s.v[i] = v[i];
         s.mode[i] = modes[i];
     }
-    double y[16], t = 0.4;
-    bk_island isl = island_of(&s, 0, 0, 4);
+    double y[MAX_Y], t = 0.4;
+    bk_island isl = island_of(&s, 0, 0, nb);
     bk_island_restart(&isl, t, y);
     size_t n = isl.n_y;
     dense jac = {n, calloc(n * n, sizeof(double))};
     assert_non_null(jac.a);
     if (implicit_part) {
         assert_int_equal(bk_island_jacobian_implicit(t, y, &isl, put_dense, &jac), 0);
-        double whole[16], f_explicit[16], f_implicit[16];
+        double whole[MAX_Y], f_explicit[MAX_Y], f_implicit[MAX_Y];
         bk_island_rhs(t, y, whole, &isl);
         bk_island_rhs_split(t, y, f_explicit, f_implicit, &isl);
         for (size_t r = 0; r < n; ++r)
             assert_close(f_explicit[r] + f_implicit[r], whole[r], 1e-15, 1e-300);
         /* Friction only: positions and the energy quadratures are all explicit. */
-        for (size_t i = 0; i < 4; ++i)
+        for (size_t i = 0; i < nb; ++i)
             if (s.slot[i] != SIZE_MAX)
                 assert_true(f_implicit[s.slot[i]] == 0.0);
         for (size_t e = n - s.n_energy; e < n; ++e)
@@ -378,7 +395,7 @@ static void check_jacobian(int full_layout, int implicit_part, int damped)
     } else {
         assert_int_equal(bk_island_jacobian(t, y, &isl, put_dense, &jac), 0);
     }
-    double up[16], down[16];
+    double up[MAX_Y], down[MAX_Y];
     for (size_t c = 0; c < n; ++c) {
         double saved = y[c], h = 1e-7 * fmax(fabs(saved), 1e-2); /* 1e-2: not below rounding where y is 0 */
         y[c] = saved + h;
@@ -391,8 +408,14 @@ static void check_jacobian(int full_layout, int implicit_part, int damped)
             double scale = fmax(fabs(fd), fabs(jac.a[r * n + c]));
             if (fabs(fd - jac.a[r * n + c]) > 1e-5 * scale + 1e-9)
                 fail_msg("J[%zu][%zu] = %.10g, difference quotient %.10g", r, c, jac.a[r * n + c], fd);
+            size_t distance = r > c ? r - c : c - r;
+            if (shape == LATTICE_WALLS && r < n - s.n_energy && distance > isl.half_bandwidth && jac.a[r * n + c] != 0.0)
+                fail_msg("J[%zu][%zu] = %.10g outside the half bandwidth %zu", r, c, jac.a[r * n + c],
+                         isl.half_bandwidth);
         }
     }
+    if (shape == LATTICE_WALLS) /* a row apart: more than a chain's neighbours */
+        assert_true(isl.half_bandwidth > 3 + s.max_block_state);
     free(jac.a);
     bk_island_free(&isl);
     bk_scene_free(&s);
@@ -402,11 +425,12 @@ static void check_jacobian(int full_layout, int implicit_part, int damped)
 static void test_jacobian(void **state)
 {
     (void)state;
-    for (int damped = 0; damped < 2; ++damped) {
-        check_jacobian(0, 0, damped);
-        check_jacobian(1, 0, damped);
-        check_jacobian(0, 1, damped);
-    }
+    for (int shape = CHAIN; shape <= TORUS; ++shape)
+        for (int damped = 0; damped < 2; ++damped) {
+            check_jacobian(0, 0, damped, shape);
+            check_jacobian(1, 0, damped, shape);
+            check_jacobian(0, 1, damped, shape);
+        }
 }
 
 int main(void)

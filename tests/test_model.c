@@ -1,5 +1,5 @@
-/* Chain forces and energies: hand-computed forces for every boundary, energy gradients
- * against forces, the frequency bound against GSL's eigenvalues. */
+/* Chain and lattice forces and energies: hand-computed forces for every boundary, energy
+ * gradients against forces, the frequency bound against GSL's eigenvalues. */
 #include <gsl/gsl_eigen.h>
 #include <gsl/gsl_matrix.h>
 #include <stdlib.h>
@@ -11,7 +11,7 @@ static bk_model *make_chain(size_t n, bk_boundary boundary, bk_spring spring)
 {
     bk_model *m = bk_model_create(n);
     assert_non_null(m);
-    m->boundary = boundary;
+    m->boundary_cols = boundary;
     m->spring = spring;
     m->coupling_stiffness = 2.385e3;
     for (size_t i = 0; i < n; ++i) {
@@ -53,11 +53,13 @@ static void test_forces_fixed_and_periodic(void **state)
     assert_close(bk_model_coupling_force(one_ring, 0, x), 0.0, 0, 0);
     bk_model *one_fixed = make_chain(1, BK_BOUNDARY_FIXED, BK_SPRING_LINEAR);
     assert_close(bk_model_coupling_force(one_fixed, 0, x), -2.0 * kc * x[0], 1e-15, 0);
-    long left, right;
+    long partners[BK_MAX_NEIGHBOURS];
     bk_model *two_ring = make_chain(2, BK_BOUNDARY_PERIODIC, BK_SPRING_LINEAR);
-    bk_model_neighbours(two_ring, 0, &left, &right);
-    assert_int_equal(left, 1);
-    assert_int_equal(right, 1);
+    bk_model_neighbours(two_ring, 0, partners);
+    assert_int_equal(partners[BK_LEFT], 1);
+    assert_int_equal(partners[BK_RIGHT], 1);
+    assert_int_equal(partners[BK_UP], -1);
+    assert_int_equal(partners[BK_DOWN], -1);
     bk_model_free(fixed);
     bk_model_free(ring);
     bk_model_free(one_ring);
@@ -99,10 +101,10 @@ static void test_damping(void **state)
     bk_model *one = make_chain(1, BK_BOUNDARY_FREE, BK_SPRING_LINEAR);
     one->coupling_damping = etac;
     assert_false(bk_model_is_damped(one));
-    one->boundary = BK_BOUNDARY_FIXED;
+    one->boundary_cols = BK_BOUNDARY_FIXED;
     assert_true(bk_model_is_damped(one));
     assert_close(bk_model_damping_force(one, 0, v), -2.0 * etac * v[0], 1e-15, 0);
-    one->boundary = BK_BOUNDARY_FREE;
+    one->boundary_cols = BK_BOUNDARY_FREE;
     one->blocks[0].damping = 7.5;
     assert_true(bk_model_is_damped(one));
     assert_close(bk_model_damping_force(one, 0, v), -7.5 * v[0], 1e-15, 0);
@@ -140,6 +142,95 @@ static void test_energy_gradient(void **state)
                     x[i] = saved;
                     double force = bk_model_applied_force(m, i, x, D);
                     assert_close(-(up - down) / (2 * h), force, 1e-6, 1e-9);
+                }
+                bk_model_free(m);
+            }
+}
+
+static bk_model *make_lattice(size_t rows, size_t cols, bk_boundary boundary_rows, bk_boundary boundary_cols)
+{
+    bk_model *m = make_chain(rows * cols, boundary_cols, BK_SPRING_LINEAR);
+    m->rows = rows;
+    m->cols = cols;
+    m->boundary_rows = boundary_rows;
+    return m;
+}
+
+/* Partners on a 3 x 4 lattice by direction, at a corner, an edge and inside, for each
+ * boundary; a 2-row periodic direction couples twice to the other row. */
+static void test_lattice_neighbours(void **state)
+{
+    (void)state;
+    long p[BK_MAX_NEIGHBOURS];
+    bk_model *free_lattice = make_lattice(3, 4, BK_BOUNDARY_FREE, BK_BOUNDARY_FREE);
+    assert_int_equal(bk_model_directions(free_lattice), 4);
+    bk_model_neighbours(free_lattice, 0, p); /* top-left corner */
+    assert_int_equal(p[BK_LEFT], -1);
+    assert_int_equal(p[BK_RIGHT], 1);
+    assert_int_equal(p[BK_UP], -1);
+    assert_int_equal(p[BK_DOWN], 4);
+    bk_model_neighbours(free_lattice, 5, p); /* inside: row 1, column 1 */
+    assert_int_equal(p[BK_LEFT], 4);
+    assert_int_equal(p[BK_RIGHT], 6);
+    assert_int_equal(p[BK_UP], 1);
+    assert_int_equal(p[BK_DOWN], 9);
+    assert_int_equal(bk_model_coupling_count(free_lattice, 5), 4);
+    assert_int_equal(bk_model_coupling_count(free_lattice, 11), 2);
+    bk_model *torus = make_lattice(3, 4, BK_BOUNDARY_PERIODIC, BK_BOUNDARY_PERIODIC);
+    bk_model_neighbours(torus, 0, p);
+    assert_int_equal(p[BK_LEFT], 3);
+    assert_int_equal(p[BK_UP], 8);
+    bk_model_neighbours(torus, 11, p); /* bottom-right corner */
+    assert_int_equal(p[BK_RIGHT], 8);
+    assert_int_equal(p[BK_DOWN], 3);
+    bk_model *walls = make_lattice(3, 4, BK_BOUNDARY_FIXED, BK_BOUNDARY_FREE);
+    bk_model_neighbours(walls, 9, p); /* bottom row: a wall below, none to the right of column 3 */
+    assert_int_equal(p[BK_DOWN], -2);
+    assert_int_equal(p[BK_UP], 5);
+    bk_model_neighbours(walls, 11, p);
+    assert_int_equal(p[BK_RIGHT], -1);
+    bk_model *two_rows = make_lattice(2, 3, BK_BOUNDARY_PERIODIC, BK_BOUNDARY_FREE);
+    bk_model_neighbours(two_rows, 1, p);
+    assert_int_equal(p[BK_UP], 4);
+    assert_int_equal(p[BK_DOWN], 4);
+    /* One row between fixed walls: partners up and down are walls; a chain has none. */
+    bk_model *strip = make_lattice(1, 3, BK_BOUNDARY_FIXED, BK_BOUNDARY_FREE);
+    assert_int_equal(bk_model_directions(strip), 4);
+    assert_int_equal(bk_model_coupling_count(strip, 1), 4);
+    bk_model *chain = make_chain(3, BK_BOUNDARY_FREE, BK_SPRING_LINEAR);
+    assert_int_equal(bk_model_directions(chain), 2);
+    double x[12] = {1e-3, -2e-3, 4e-3, 0.5e-3, 2e-3, -1e-3, 3e-3, 0.0, -4e-3, 1.5e-3, 0.7e-3, -0.2e-3};
+    double kc = free_lattice->coupling_stiffness;
+    assert_close(bk_model_coupling_force(free_lattice, 5, x),
+                 kc * (x[4] - x[5]) + kc * (x[6] - x[5]) + kc * (x[1] - x[5]) + kc * (x[9] - x[5]), 1e-15, 0);
+    assert_close(bk_model_coupling_force(walls, 9, x),
+                 kc * (x[8] - x[9]) + kc * (x[10] - x[9]) + kc * (x[5] - x[9]) + kc * (0.0 - x[9]), 1e-15, 0);
+    bk_model *models[] = {free_lattice, torus, walls, two_rows, strip, chain};
+    for (size_t k = 0; k < sizeof models / sizeof models[0]; ++k)
+        bk_model_free(models[k]);
+}
+
+/* On lattices too the force is minus the energy's gradient (each spring counted once, the
+ * doubled springs of a two-line periodic direction twice), for every pair of boundaries. */
+static void test_lattice_energy_gradient(void **state)
+{
+    (void)state;
+    const bk_boundary boundaries[] = {BK_BOUNDARY_FREE, BK_BOUNDARY_FIXED, BK_BOUNDARY_PERIODIC};
+    const size_t shapes[][2] = {{2, 3}, {3, 3}, {1, 4}, {4, 1}, {3, 2}};
+    for (size_t br = 0; br < 3; ++br)
+        for (size_t bc = 0; bc < 3; ++bc)
+            for (size_t sh = 0; sh < sizeof shapes / sizeof shapes[0]; ++sh) {
+                bk_model *m = make_lattice(shapes[sh][0], shapes[sh][1], boundaries[br], boundaries[bc]);
+                double x[9] = {1.1e-3, -2.3e-3, 4.7e-3, 0.3e-3, -0.9e-3, 2.2e-3, 3.1e-3, -1.7e-3, 0.6e-3};
+                double D = 2e-3;
+                for (size_t i = 0; i < m->n_blocks; ++i) {
+                    double h = 1e-7, saved = x[i];
+                    x[i] = saved + h;
+                    double up = bk_model_elastic_energy(m, x, D);
+                    x[i] = saved - h;
+                    double down = bk_model_elastic_energy(m, x, D);
+                    x[i] = saved;
+                    assert_close(-(up - down) / (2 * h), bk_model_applied_force(m, i, x, D), 1e-6, 1e-9);
                 }
                 bk_model_free(m);
             }
@@ -195,6 +286,8 @@ int main(void)
         cmocka_unit_test(test_damping),
         cmocka_unit_test(test_tension_only),
         cmocka_unit_test(test_energy_gradient),
+        cmocka_unit_test(test_lattice_neighbours),
+        cmocka_unit_test(test_lattice_energy_gradient),
         cmocka_unit_test(test_kinetic_energy),
         cmocka_unit_test(test_frequency_bound),
     };

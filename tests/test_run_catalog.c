@@ -114,7 +114,7 @@ static double force_at(const void *user, size_t i)
 static bk_event *rebuild(const bk_config *c, const catalog_sink *s, size_t *count)
 {
     const bk_model *m = c->model;
-    bk_catalog *b = bk_catalog_create(m->n_blocks, m->boundary == BK_BOUNDARY_PERIODIC,
+    bk_catalog *b = bk_catalog_create(m->n_blocks, m->boundary_cols == BK_BOUNDARY_PERIODIC,
                                       c->catalog.magnitude_offset);
     assert_non_null(b);
     bk_event *out = calloc(s->n_transitions + 2, sizeof *out);

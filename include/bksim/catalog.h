@@ -21,7 +21,10 @@ typedef struct bk_event {
     int32_t first_block;     /* the epicentre: the first block to slip (lowest index if several) */
     int32_t n_blocks;        /* distinct blocks that slipped */
     int32_t left, right;     /* extent, blocks left..right; on a ring the shorter arc that
-                                covers them, so left > right when it wraps past block 0 */
+                                covers them, so left > right when it wraps past block 0.  On
+                                a lattice the bounding box: left its top-left corner, right
+                                its bottom-right one (row = block / cols, column = block %
+                                cols; each direction's span taken as a chain's) */
     int32_t n_episodes;      /* slip episodes (a block that slips twice counts twice) */
     double potency;          /* m: sum over episodes of |x at stick - x at slip onset| */
     double magnitude;        /* (2/3) log10(potency / 1 m) + magnitude_offset; -inf if 0 */
@@ -36,6 +39,9 @@ typedef struct bk_catalog bk_catalog;
 /* A builder for n_blocks blocks (ring: periodic boundary) with the magnitude offset; NULL
  * when out of memory. */
 bk_catalog *bk_catalog_create(size_t n_blocks, int ring, double magnitude_offset);
+/* The same for a rows x cols lattice, each direction a ring or not. */
+bk_catalog *bk_catalog_create_lattice(size_t rows, size_t cols, int ring_rows, int ring_cols,
+                                      double magnitude_offset);
 void bk_catalog_free(bk_catalog *catalog);
 /* The applied (driver plus coupling) force on block i, N. */
 typedef double (*bk_catalog_force_fn)(const void *user, size_t i);
@@ -57,7 +63,8 @@ void bk_catalog_slip_rate(bk_catalog *catalog, double slip_rate);
 double bk_catalog_max_slip_rate(const bk_catalog *catalog);
 /* The end of the run at t, with every block's position there: an event
  * whose end was pending is completed; one still running is returned with complete = 0,
- * its open slip episodes counted up to t.  Returns 1 when it wrote an event, else 0. */
+ * its open slip episodes counted up to t.  Returns 1 when it wrote an event, 0 when there
+ * was none, BK_ERR_NOMEM when out of memory. */
 int bk_catalog_finish(bk_catalog *catalog, double t, const double *x, bk_catalog_force_fn force,
                       const void *user, bk_event *event);
 

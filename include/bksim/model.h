@@ -1,16 +1,18 @@
-/* The Burridge-Knopoff chain: N blocks on a rigid surface, neighbours joined by coupling
- * springs, each block pulled by its own driver spring.
+/* The Burridge-Knopoff model: N blocks on a rigid surface in a rows x cols lattice (a chain
+ * is one row), nearest neighbours joined by coupling springs, each block pulled by its own
+ * driver spring.
  *
  *   m_i x_i'' = F_i(x, D(t)) + G_i(v) - s_i f_i
  *   F_i = k_i (D - x_i)          driver spring (tension_only: k_i max(0, D - x_i))
- *       + kc (x_{i+1} - x_i) + kc (x_{i-1} - x_i)   coupling, per the boundary
+ *       + sum_j kc (x_j - x_i)   coupling to the neighbours j (left, right, up, down)
  *   G_i = -eta_i v_i             dashpot to the substrate (radiation damping)
- *       + etac (v_{i+1} - v_i) + etac (v_{i-1} - v_i)   dashpots beside the coupling springs
+ *       + sum_j etac (v_j - v_i) dashpots beside the coupling springs
  *
  * x_i is the displacement from the relaxed reference configuration (m), D the driver
- * displacement, f_i the friction force magnitude, s_i the slip direction.  Boundaries:
- * free (end blocks have one neighbour), fixed (end blocks also tied to a wall at 0),
- * periodic (block N-1 couples to block 0). */
+ * displacement, f_i the friction force magnitude, s_i the slip direction.  Block i sits at
+ * row i / cols, column i % cols.  Boundaries, per direction: free (edge blocks have one
+ * neighbour that way), fixed (edge blocks also tied to a wall at 0), periodic (the last
+ * block couples to the first; a direction one block long then has no spring). */
 #ifndef BKSIM_MODEL_H
 #define BKSIM_MODEL_H
 
@@ -43,9 +45,14 @@ typedef struct bk_block {
     size_t state_offset;     /* first friction state of this block in the model's state array */
 } bk_block;
 
+/* Neighbour directions, in the order forces are summed: a chain uses the first two. */
+enum { BK_LEFT = 0, BK_RIGHT = 1, BK_UP = 2, BK_DOWN = 3, BK_MAX_NEIGHBOURS = 4 };
+
 typedef struct bk_model {
     size_t n_blocks;
-    bk_boundary boundary;
+    size_t rows, cols;          /* n_blocks = rows * cols, row-major; bk_model_create: 1 x n */
+    bk_boundary boundary_cols;  /* at the first and last column: a chain's ends */
+    bk_boundary boundary_rows;  /* at the first and last row */
     double coupling_stiffness; /* N/m, >= 0 */
     double coupling_damping;   /* N s/m, >= 0: dashpot in parallel with every coupling spring */
     double gravity;            /* m/s^2, used for default normal forces */
@@ -55,7 +62,8 @@ typedef struct bk_model {
     size_t n_friction_state;   /* sum of the blocks' law->n_state */
 } bk_model;
 
-/* Allocate a model of n blocks, zeroed; NULL on allocation failure. */
+/* Allocate a model of n blocks, zeroed, a chain (1 x n, free ends); NULL on allocation
+ * failure. */
 bk_model *bk_model_create(size_t n_blocks);
 void bk_model_free(bk_model *model);
 /* Assign friction state offsets; call after the blocks' laws are set. */
@@ -78,10 +86,14 @@ double bk_model_elastic_energy(const bk_model *model, const double *x, double dr
 double bk_model_kinetic_energy(const bk_model *model, const double *v);
 /* Upper bound on the chain's highest natural angular frequency (rad/s), Gershgorin. */
 double bk_model_max_angular_frequency(const bk_model *model);
-/* Coupling partners of block i: a block index, -1 for none, or -2 for a fixed wall at
- * displacement 0.  With periodic ends and two blocks both partners are the other block. */
-void bk_model_neighbours(const bk_model *model, size_t i, long *left, long *right);
-/* Number of neighbours block i is coupled to (walls included), 0..2. */
+/* Directions with coupling partners: 2 on a chain (left, right), 4 on a lattice (or a row
+ * between fixed walls above and below). */
+size_t bk_model_directions(const bk_model *model);
+/* Coupling partners of block i, by direction (BK_LEFT ..): a block index, -1 for none, or
+ * -2 for a fixed wall at displacement 0; partners[d] for d >= bk_model_directions are -1.
+ * With periodic ends two blocks long both partners that way are the other block. */
+void bk_model_neighbours(const bk_model *model, size_t i, long partners[BK_MAX_NEIGHBOURS]);
+/* Number of neighbours block i is coupled to (walls included), 0..4. */
 int bk_model_coupling_count(const bk_model *model, size_t i);
 /* Block i's own stiffness (N/m): its driver spring and its coupling springs, the others held
  * fixed; sqrt of it over the mass is the block's natural angular frequency. */

@@ -325,12 +325,16 @@ static int cmd_check(int argc, char **argv)
             snprintf(driver, sizeof driver, "a history of %zu segments", m->driver.n_segments);
         else
             snprintf(driver, sizeof driver, "%g m/s", m->driver.velocity);
-        printf("%s: ok: %zu block%s, %s boundary, %s driver spring, driver %s, t_end %g s, "
+        static const char *const boundary_names[] = {"free", "fixed", "periodic"};
+        char shape[160];
+        if (bk_model_directions(m) == 2)
+            snprintf(shape, sizeof shape, "%s boundary", boundary_names[m->boundary_cols]);
+        else
+            snprintf(shape, sizeof shape, "a %zu x %zu lattice, %s rows boundary, %s cols boundary", m->rows,
+                     m->cols, boundary_names[m->boundary_rows], boundary_names[m->boundary_cols]);
+        printf("%s: ok: %zu block%s, %s, %s driver spring, driver %s, t_end %g s, "
                "method %s, output %s\n",
-               args.config_path, m->n_blocks, m->n_blocks == 1 ? "" : "s",
-               m->boundary == BK_BOUNDARY_FREE    ? "free"
-               : m->boundary == BK_BOUNDARY_FIXED ? "fixed"
-                                                  : "periodic",
+               args.config_path, m->n_blocks, m->n_blocks == 1 ? "" : "s", shape,
                m->spring == BK_SPRING_LINEAR ? "linear" : "tension-only", driver,
                config->t_end, config->solver.method, config->output.path);
     }

@@ -385,6 +385,12 @@ int bk_h5_info_blocks(const char *path, FILE *out, int per_block, bk_error *err)
     fprintf(out, "t_end        %.9g s\n", t_end);
     fprintf(out, "t_reached    %.9g s\n", t_reached);
     fprintf(out, "n_blocks     %lld\n", n_blocks);
+    /* Files from before lattices have no shape: a chain. */
+    long long lattice_rows = 1, lattice_cols = n_blocks;
+    if (bk_h5_read_numeric_attr(file, "rows", H5T_NATIVE_LLONG, &lattice_rows) >= 0 &&
+        bk_h5_read_numeric_attr(file, "cols", H5T_NATIVE_LLONG, &lattice_cols) >= 0 && lattice_rows > 1)
+        fprintf(out, "lattice      %lld rows x %lld cols (block i at row i / cols, column i %% cols)\n", lattice_rows,
+                lattice_cols);
     if (have_rows)
         fprintf(out, "rows         %llu\n", (unsigned long long)rows);
     else

@@ -135,6 +135,8 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
         bk_h5_write_string_attr(w->file, "config_name", config->source_name) < 0 ||
         bk_h5_write_string_attr(w->file, "version", BKSIM_VERSION) < 0 ||
         bk_h5_write_long_attr(w->file, "n_blocks", (long long)model->n_blocks) < 0 ||
+        bk_h5_write_long_attr(w->file, "rows", (long long)model->rows) < 0 ||
+        bk_h5_write_long_attr(w->file, "cols", (long long)model->cols) < 0 ||
         bk_h5_write_double_attr(w->file, "t_end", config->t_end) < 0 ||
         bk_h5_write_int_attr(w->file, "complete", 0) < 0 ||
         bk_h5_write_double_attr(w->file, "t_reached", 0.0) < 0 ||

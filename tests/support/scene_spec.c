@@ -21,7 +21,7 @@ bk_config *scene_config(const scene_spec *spec)
     assert_non_null(c);
     bk_model *m = bk_model_create(spec->n);
     assert_non_null(m);
-    m->boundary = spec->boundary;
+    m->boundary_cols = spec->boundary;
     m->coupling_stiffness = spec->coupling;
     m->gravity = 9.81;
     m->spring = spec->spring;
