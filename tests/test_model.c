@@ -122,6 +122,22 @@ static void test_tension_only(void **state)
     bk_model_free(m);
 }
 
+/* Each block's applied force is minus the elastic energy's derivative by its position. */
+static void check_gradient(const bk_model *m)
+{
+    double x[9] = {1.1e-3, -2.3e-3, 4.7e-3, 0.3e-3, -0.9e-3, 2.2e-3, 3.1e-3, -1.7e-3, 0.6e-3}, D = 2e-3;
+    assert_true(m->n_blocks <= 9);
+    for (size_t i = 0; i < m->n_blocks; ++i) {
+        double h = 1e-7, saved = x[i];
+        x[i] = saved + h;
+        double up = bk_model_elastic_energy(m, x, D);
+        x[i] = saved - h;
+        double down = bk_model_elastic_energy(m, x, D);
+        x[i] = saved;
+        assert_close(-(up - down) / (2 * h), bk_model_applied_force(m, i, x, D), 1e-6, 1e-9);
+    }
+}
+
 /* The force is minus the gradient of the elastic energy, for every boundary and spring. */
 static void test_energy_gradient(void **state)
 {
@@ -132,17 +148,7 @@ static void test_energy_gradient(void **state)
         for (size_t s = 0; s < 2; ++s)
             for (size_t n = 1; n <= 4; ++n) {
                 bk_model *m = make_chain(n, boundaries[b], springs[s]);
-                double x[4] = {1.1e-3, -2.3e-3, 4.7e-3, 0.3e-3}, D = 2e-3;
-                for (size_t i = 0; i < n; ++i) {
-                    double h = 1e-7, saved = x[i];
-                    x[i] = saved + h;
-                    double up = bk_model_elastic_energy(m, x, D);
-                    x[i] = saved - h;
-                    double down = bk_model_elastic_energy(m, x, D);
-                    x[i] = saved;
-                    double force = bk_model_applied_force(m, i, x, D);
-                    assert_close(-(up - down) / (2 * h), force, 1e-6, 1e-9);
-                }
+                check_gradient(m);
                 bk_model_free(m);
             }
 }
@@ -221,17 +227,7 @@ static void test_lattice_energy_gradient(void **state)
         for (size_t bc = 0; bc < 3; ++bc)
             for (size_t sh = 0; sh < sizeof shapes / sizeof shapes[0]; ++sh) {
                 bk_model *m = make_lattice(shapes[sh][0], shapes[sh][1], boundaries[br], boundaries[bc]);
-                double x[9] = {1.1e-3, -2.3e-3, 4.7e-3, 0.3e-3, -0.9e-3, 2.2e-3, 3.1e-3, -1.7e-3, 0.6e-3};
-                double D = 2e-3;
-                for (size_t i = 0; i < m->n_blocks; ++i) {
-                    double h = 1e-7, saved = x[i];
-                    x[i] = saved + h;
-                    double up = bk_model_elastic_energy(m, x, D);
-                    x[i] = saved - h;
-                    double down = bk_model_elastic_energy(m, x, D);
-                    x[i] = saved;
-                    assert_close(-(up - down) / (2 * h), bk_model_applied_force(m, i, x, D), 1e-6, 1e-9);
-                }
+                check_gradient(m);
                 bk_model_free(m);
             }
 }
