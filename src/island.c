@@ -401,6 +401,18 @@ static void friction_derivatives(const bk_scene *scene, size_t i, double slip_ra
     *d_state = (up - down) / (2.0 * hs);
 }
 
+/* `value` at (row, slot + offset) of each partner of block i this island integrates: the
+ * coupling's entries, to a partner's position (offset 0) or velocity (1). */
+static void put_partners(const bk_island *island, size_t i, size_t row, size_t offset, double value,
+                         void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
+{
+    const bk_scene *scene = island->scene;
+    const long *partner = bk_scene_partners(scene, i);
+    for (size_t d = 0; d < scene->n_directions; ++d)
+        if (partner[d] >= 0 && scene->slot[partner[d]] != BK_NO_SLOT && scene->island_of[partner[d]] == island->id)
+            put(matrix, row, scene->slot[partner[d]] + offset, value);
+}
+
 /* The dashpots' part for block i (integrated at slot s): d accel / d v of it and of its
  * partners here, and the dissipation rate's d / d v_i = -2 G_i (see rhs_parts). */
 static void damping_jacobian(const bk_island *island, const double *y, size_t i, size_t s, int with_energy,
@@ -411,11 +423,8 @@ static void damping_jacobian(const bk_island *island, const double *y, size_t i,
     double etac = model->coupling_damping, m = model->blocks[i].mass;
     if (!bk_scene_stuck(scene, i)) {
         put(matrix, s + 1, s + 1, -(model->blocks[i].damping + etac * bk_scene_coupling_count(scene, i)) / m);
-        const long *partner = bk_scene_partners(scene, i);
-        for (size_t d = 0; d < scene->n_directions && etac > 0.0; ++d)
-            if (partner[d] >= 0 && scene->slot[partner[d]] != BK_NO_SLOT &&
-                scene->island_of[partner[d]] == island->id)
-                put(matrix, s + 1, scene->slot[partner[d]] + 1, etac / m);
+        if (etac > 0.0)
+            put_partners(island, i, s + 1, 1, etac / m, put, matrix);
     }
     if (with_energy)
         put(matrix, island->n_y - 1, s + 1, -2.0 * damping_force(island, y, i));
@@ -440,11 +449,8 @@ static void jacobian_parts(const bk_island *island, const double *y, int frictio
             put(matrix, s, s + 1, 1.0); /* xi' = v */
             /* Springs: the block's own stiffness, and its partners integrated here. */
             put(matrix, s + 1, s, -(spring + kc * bk_scene_coupling_count(scene, i)) / m);
-            const long *partner = bk_scene_partners(scene, i);
-            for (size_t d = 0; d < scene->n_directions && kc > 0.0; ++d)
-                if (partner[d] >= 0 && scene->slot[partner[d]] != BK_NO_SLOT &&
-                    scene->island_of[partner[d]] == island->id)
-                    put(matrix, s + 1, scene->slot[partner[d]], kc / m);
+            if (kc > 0.0)
+                put_partners(island, i, s + 1, 0, kc / m, put, matrix);
         }
         /* Friction: -dir F(dir v, state) / m. */
         const double *state = block_state(island, y, i);

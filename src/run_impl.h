@@ -144,6 +144,13 @@ typedef struct run_ctx {
     bk_catalog_state catalog_state; /* what a checkpoint saves (arrays only with checkpoints) */
 } run_ctx;
 
+/* qsort's order of block indices (size_t). */
+static inline int bk_compare_blocks(const void *a, const void *b)
+{
+    size_t x = *(const size_t *)a, y = *(const size_t *)b;
+    return (x > y) - (x < y);
+}
+
 /* ---- run.c ---- */
 double bk_run_wall_seconds(void);
 /* The wall-clock limit and a stop request, checked at every step and row. */

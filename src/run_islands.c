@@ -573,12 +573,6 @@ int bk_run_island_event(run_ctx *ctx, size_t id)
     return bk_run_repartition(ctx, island->blocks, island->len, t, id);
 }
 
-static int by_block(const void *a, const void *b)
-{
-    size_t x = *(const size_t *)a, y = *(const size_t *)b;
-    return (x > y) - (x < y);
-}
-
 int bk_run_quiet_failures(run_ctx *ctx, double t)
 {
     bk_scene *scene = &ctx->scene;
@@ -588,7 +582,7 @@ int bk_run_quiet_failures(run_ctx *ctx, double t)
     size_t count = 0;
     while (!bk_heap_empty(&ctx->quiet) && bk_heap_top_key(&ctx->quiet) <= limit)
         ctx->batch[count++] = bk_heap_pop(&ctx->quiet);
-    qsort(ctx->batch, count, sizeof *ctx->batch, by_block);
+    qsort(ctx->batch, count, sizeof *ctx->batch, bk_compare_blocks);
     double driver_pos = bk_driver_position(&model->driver, t);
     /* The force crosses the threshold the way the driver pulls; passing that direction
      * instead of the force itself is immune to rounding at the threshold.  A resting driver

@@ -56,12 +56,6 @@ static void region_add(run_ctx *ctx, size_t i)
     ctx->region[ctx->n_region++] = i;
 }
 
-static int by_value(const void *a, const void *b)
-{
-    size_t x = *(const size_t *)a, y = *(const size_t *)b;
-    return (x > y) - (x < y);
-}
-
 /* Where the island's order starts along one periodic direction (columns, or rows) of `len`
  * lines: the first occupied line after the widest empty stretch.  When every line is
  * occupied, the first line no spring in the ODE joins to the one before (only stuck blocks
@@ -86,7 +80,7 @@ static size_t cut_of(run_ctx *ctx, size_t count, int columns, size_t len)
         }
     if (starts > 1) {
         /* Several empty stretches (a lattice island's outline): the widest one ends the order. */
-        qsort(lines, distinct, sizeof *lines, by_value);
+        qsort(lines, distinct, sizeof *lines, bk_compare_blocks);
         size_t widest = len - lines[distinct - 1] + lines[0];
         start = lines[0];
         for (size_t k = 1; k < distinct; ++k)
@@ -133,7 +127,7 @@ static void order_members(run_ctx *ctx, size_t count)
         for (size_t k = 0; k < count; ++k)
             members[k] = lo + k;
     else
-        qsort(members, count, sizeof *members, by_value);
+        qsort(members, count, sizeof *members, bk_compare_blocks);
     for (size_t k = 0; k < count; ++k) {
         size_t row = (members[k] / cols + row_cut) % rows, col = (members[k] % cols + col_cut) % cols;
         members[k] = row * cols + col;

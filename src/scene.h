@@ -137,8 +137,8 @@ static inline void bk_energy_add(bk_energy *sum, const bk_energy *more)
     sum->damping += more->damping;
 }
 
-/* An island: len blocks, listed in the partition's order (run_islands.c: a chain's run from
- * its first block, a lattice's blocks row by row), so that coupled blocks sit close in y. */
+/* An island: len blocks, listed in the partition's order (run_partition.c: a chain's run
+ * from its first block, a lattice's blocks row by row), so that coupled blocks sit close in y. */
 typedef struct bk_island {
     bk_scene *scene;
     size_t id;               /* index in the run's island table */
