@@ -1275,6 +1275,31 @@ static void test_catalog_scripts(void **state)
     assert_true(path_exists(cmd));
     snprintf(cmd, sizeof cmd, "%s/fig/ends_spacetime.png", tmpdir);
     assert_true(path_exists(cmd));
+
+    /* plot_slip_map.sh on a 4 x 5 lattice: the largest event, a chosen one, and one past the end. */
+    snprintf(path, sizeof path, "%s/sheet.ini", tmpdir);
+    f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("[model]\nrows = 4\ncols = 5\ncoupling_stiffness = 2e4\n"
+          "[block]\nmass = 1\ndriver_stiffness = 1e4\nx_init_random = 2e-5\n"
+          "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
+          "[driver]\nvelocity = 1e-3\n[output]\ninterval = 0\n[run]\nt_end = 0.5\n",
+          f);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s/sheet.h5 --quiet", path, tmpdir);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh -o %s/fig %s/sheet.h5", bin, tmpdir, tmpdir);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_non_null(strstr(text, "/fig/sheet_slip_map_"));
+    free(text);
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh --format svg --event 0 -o %s/fig %s/sheet.h5", bin,
+             tmpdir, tmpdir);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    snprintf(cmd, sizeof cmd, "%s/fig/sheet_slip_map_0.svg", tmpdir);
+    assert_true(path_exists(cmd));
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh --event 99999 -o %s/fig %s/sheet.h5", bin, tmpdir,
+             tmpdir);
+    expect_command(cmd, 1, "out of range");
 }
 
 /* The benchmark's smoke run: every back-end on case B at three tolerances, all succeed

@@ -1,0 +1,240 @@
+#!/usr/bin/env bash
+# One event's slip over a 2D lattice, as OUTDIR/<stem>_slip_map_<K>.<fmt>: a map of rows x
+# cols cells (block i at row i / cols, column i % cols; row 0 on top; a chain is one row),
+# each coloured by how far block i slipped in the event (m).  With /transitions (the
+# default) that is exact: x at the block's last transition in the event minus x at its
+# first.  Without, or for an event still running at the end, it is x in the first sample
+# row at or after t_end (else the last row) minus x in the last one at or before t_start,
+# which also counts whatever else moved between those rows.  The epicentre (first_block) is a point, the event's
+# bounding box (left..right) a rectangle, in pieces when it wraps round a periodic edge.
+# K is the 0-based row of /events (`bksim export FILE --events`); by default, or with
+# --largest, the event of largest potency.  <stem> is FILE's name without .h5 (and .part);
+# OUTDIR defaults to FILE's directory.
+# usage: plot_slip_map.sh [--format png|pdf|svg] [-o OUTDIR] [--event K | --largest] FILE.h5
+set -euo pipefail
+me=plot_slip_map.sh
+here=$(dirname "$0")
+# shellcheck source-path=SCRIPTDIR source=plot_lib.sh disable=SC1091 # followed with -x
+source "$here/plot_lib.sh"
+bksim=${BKSIM:-./bksim}
+# Run from elsewhere, use the build next to this script.
+[ -n "${BKSIM:-}" ] || [ -x "$bksim" ] || bksim="$here/../bksim"
+
+usage() { echo "usage: $me [--format png|pdf|svg] [-o OUTDIR] [--event K | --largest] FILE.h5" >&2; exit 2; }
+fail() { echo "$me: $*" >&2; exit 1; }
+
+format=png; outdir=""; file=""; event=""
+while [ $# -gt 0 ]; do
+    case $1 in
+        --format) [ $# -ge 2 ] || usage; format=$2; shift 2 ;;
+        --format=*) format=${1#--format=}; shift ;;
+        -o|--output) [ $# -ge 2 ] || usage; outdir=$2; shift 2 ;;
+        --event) [ $# -ge 2 ] || usage; event=$2; shift 2 ;;
+        --event=*) event=${1#--event=}; shift ;;
+        --largest) event=""; shift ;;
+        -h|--help) sed -n '2,13s/^# \{0,1\}//p' "$0"; exit 0 ;;
+        -*) echo "$me: unknown option '$1'" >&2; usage ;;
+        *) [ -z "$file" ] || { echo "$me: unexpected argument '$1'" >&2; usage; }
+           file=$1; shift ;;
+    esac
+done
+[ -n "$file" ] || { echo "$me: missing FILE.h5" >&2; usage; }
+terminal=$(plot_terminal "$format" 2>/dev/null) ||
+    { echo "$me: --format must be png, pdf or svg, got '$format'" >&2; usage; }
+[ -z "$event" ] || [[ $event =~ ^[0-9]+$ ]] ||
+    { echo "$me: --event needs an event row >= 0, got '$event'" >&2; usage; }
+[ -e "$file" ] || fail "$file: no such file"
+[ -f "$file" ] || fail "$file: not a regular file"
+command -v gnuplot >/dev/null 2>&1 || fail "needs gnuplot (Debian package gnuplot-nox)"
+[ -x "$bksim" ] || fail "no bksim binary at $bksim (build it with make, or set BKSIM)"
+outdir=${outdir:-$(dirname "$file")}
+mkdir -p "$outdir" || fail "$outdir: cannot create the output directory"
+stem=$(basename "$file"); stem=${stem%.part}; stem=${stem%.h5}
+
+tmp=$(mktemp -d); partial=""
+trap 'rm -rf "$tmp"; [ -z "$partial" ] || rm -f "$partial"' EXIT
+"$bksim" export "$file" --events > "$tmp/events.tsv" 2> "$tmp/err" ||
+    fail "$(cat "$tmp/err")"
+
+# The event: row K, or the largest finite potency (the first of equals; row 0 if none is
+# finite).  Its fields, tab-separated, go to the shell in one read.
+n_events=$(awk '!/^#/' "$tmp/events.tsv" | wc -l)
+[ "$n_events" -gt 0 ] || fail "$file: /events is empty: no event to map"
+if [ -z "$event" ]; then
+    event=$(awk -F'\t' '/^#/ {next}
+        {k = n++; p = $8 + 0}
+        $8 !~ /nan|inf/ && (best == "" || p > pmax) {best = k; pmax = p}
+        END {print best == "" ? 0 : best}' "$tmp/events.tsv")
+    what="; the largest by potency"
+else
+    event=$(echo "$event" | sed 's/^0*//; s/^$/0/')
+    if [ ${#event} -gt 15 ] || [ "$event" -ge "$n_events" ]; then
+        fail "$file: --event $event out of range: /events has $n_events rows (0..$((n_events - 1)))"
+    fi
+    what=""
+fi
+IFS=$'\t' read -r t_start t_end first_block ev_blocks left right _ _ magnitude _ _ complete < <(
+    awk -F'\t' -v k="$event" '!/^#/ && n++ == k' "$tmp/events.tsv")
+
+# The lattice's shape (bksim info; its exit status says whether the run finished, which
+# does not matter here).  No lattice line: a chain, one row.
+info=$({ "$bksim" info "$file" 2>/dev/null || true; })
+shape=$(awk '$1 == "lattice" && $3 == "rows" {print $2, $5; exit}' <<<"$info")
+read -r rows cols <<<"${shape:-0 0}"
+n_blocks=$(awk '$1 == "n_blocks" {print $2; exit}' <<<"$info")
+
+# A finished event's slip is exact from /transitions, where the run kept them: a block is
+# stuck between its episodes, so x at its last transition in the event minus x at its first
+# is all it slipped, and nothing else that moved between two sample rows counts.  They come
+# as two rows in the export's form (t_start, then t_end), so the map below takes either.
+from_transitions=0
+if [ "$complete" = 1 ] && [[ ${n_blocks:-} =~ ^[0-9]+$ ]] &&
+   awk '$1 == "transitions" && $2 ~ /^[0-9]+$/ && $2 > 0 {found = 1} END {exit !found}' <<<"$info"; then
+    from_transitions=1
+fi
+samples() {
+    if [ "$from_transitions" = 0 ]; then
+        "$bksim" export "$file" --datasets time,x
+        return
+    fi
+    "$bksim" export "$file" --transitions | awk -v ts="$t_start" -v te="$t_end" -v n="$n_blocks" '
+        /^#/ { next }
+        $1 + 0 < ts + 0 { next }
+        $1 + 0 > te + 0 { exit }
+        { if (!($2 in first)) first[$2] = $5; last[$2] = $5 }
+        END {
+            printf "%s", ts; for (i = 0; i < n; i++) printf " %.17g", (i in first) ? first[i] : 0; print ""
+            printf "%s", te; for (i = 0; i < n; i++) printf " %.17g", (i in last) ? last[i] : 0; print ""
+        }'
+}
+
+# The two sample rows, picked by awk as the export streams by (a 64x64 lattice's rows are
+# ~100 kB each: bash never holds them), then the slip per cell as "col row slip".  awk
+# stops at the "after" row; the export then dies of SIGPIPE (or a write error), which is
+# fine once awk has both rows.
+out_rc=0
+{ samples 2> "$tmp/err" || echo $? > "$tmp/export_rc"; } |
+awk -v ts="$t_start" -v te="$t_end" -v complete="$complete" -v cols="$cols" -v rows="$rows" \
+    -v info="$tmp/rows.txt" '
+    /^#/ { next }
+    # The time by hand: $1 would split all n + 1 fields of every row.
+    { n_rows++; t = substr($0, 1, match($0, /[ \t]/) - 1) + 0 }
+    # The last row at or before t_start (the first row if there is none).
+    !have_b || t <= ts + 0 { before = $0; have_b = 1 }
+    complete + 0 == 1 && t >= te + 0 { after = $0; have_a = 1; early = 1; exit }
+    { last = $0 }
+    END {
+        if (!n_rows) exit 3
+        if (!have_a) after = last != "" ? last : before
+        nb = split(before, b, " "); na = split(after, a, " ")
+        n = nb - 1
+        if (na != nb || n < 1) exit 4
+        if (rows + 0 == 0) { rows = 1; cols = n }
+        if (rows * cols != n) exit 5
+        printf "%.17g %.17g %d %d %d %d\n", b[1], a[1], n, rows, cols, early > info
+        # gnuplot images need 2 x 2 points: a single row or column is split in two halves.
+        fr = rows == 1 ? 2 : 1; fc = cols == 1 ? 2 : 1
+        for (r = 0; r < rows * fr; r++) {
+            for (c = 0; c < cols * fc; c++) {
+                i = int(r / fr) * cols + int(c / fc)
+                printf "%.10g %.10g %.10g\n", (fc == 1 ? c : c / 2 - 0.25), (fr == 1 ? r : r / 2 - 0.25),
+                       a[i + 2] - b[i + 2]
+            }
+            print ""
+        }
+    }' > "$tmp/slip.dat" || out_rc=$?
+export_rc=$(cat "$tmp/export_rc" 2>/dev/null || echo 0)
+early=0
+[ "$out_rc" -ne 0 ] || read -r t_before t_after n rows cols early < "$tmp/rows.txt"
+if [ "$export_rc" -ne 0 ] && [ "$early" -ne 1 ]; then
+    [ -s "$tmp/err" ] || fail "bksim export $file --datasets time,x failed (status $export_rc)"
+    fail "$(cat "$tmp/err")"
+fi
+case $out_rc in
+    0) ;;
+    3) fail "$file: no sample rows in /time: nothing to map" ;;
+    4) fail "$file: cannot read the rows of 'bksim export --datasets time,x'" ;;
+    5) fail "$file: the x columns do not make the ${rows} x ${cols} lattice bksim info reports" ;;
+    *) fail "awk failed reading the samples of $file" ;;
+esac
+
+# Text inside a single-quoted gnuplot string (a quote doubled).
+gpq() { local s=$1 q="'"; printf '%s' "${s//$q/$q$q}"; }
+g() { LC_ALL=C printf "%.${2:-6}g" "$1"; }
+
+# The colour range: from 0 (or the most negative slip) to the largest, never empty.
+cb_range=$(awk 'NF == 3 {if (!n++) lo = hi = $3; if ($3 < lo) lo = $3; if ($3 > hi) hi = $3}
+    END {if (lo > 0) lo = 0; if (hi < 0) hi = 0; if (hi - lo <= 0) hi = lo + 1e-9
+         printf "%.10g:%.10g", lo, hi}' "$tmp/slip.dat")
+
+# The bounding box, left = top-left corner, right = bottom-right; a span whose first
+# row/col is past its last wraps round a periodic edge: two intervals, so up to four pieces.
+span() { # FIRST LAST SIZE -> "lo hi" intervals, one a line
+    if [ "$1" -le "$2" ]; then echo "$1 $2"; else echo "$1 $(($3 - 1))"; echo "0 $2"; fi
+}
+boxes=""; n_pieces=0
+if [[ $left =~ ^[0-9]+$ && $right =~ ^[0-9]+$ ]] && [ "$left" -lt "$n" ] && [ "$right" -lt "$n" ]; then
+    while read -r r0 r1; do
+        while read -r c0 c1; do
+            n_pieces=$((n_pieces + 1))
+            boxes+="set object $n_pieces rect from $c0 - 0.5, $r0 - 0.5 to $c1 + 0.5, $r1 + 0.5 front fs empty border lc rgb '#1f77b4' lw 3 dt 2
+"
+        done < <(span $((left % cols)) $((right % cols)) "$cols")
+    done < <(span $((left / cols)) $((right / cols)) "$rows")
+fi
+box_plot=""
+if [ "$n_pieces" -gt 0 ]; then
+    box_title="bounding box, blocks $left..$right"
+    [ "$n_pieces" -eq 1 ] || box_title="$box_title (wraps: $n_pieces pieces)"
+    box_plot="NaN with lines lw 3 dt 2 lc rgb '#1f77b4' title '$(gpq "$box_title")', "
+fi
+epi_r=$((first_block / cols)); epi_c=$((first_block % cols))
+
+running=""; [ "$complete" = 1 ] || running=" (still running at the end)"
+title1="$stem: event $event (of 0..$((n_events - 1))$what), t = $(g "$t_start")..$(g "$t_end") s$running"
+blocks_word=blocks; [ "$ev_blocks" != 1 ] || blocks_word=block
+title2="$ev_blocks $blocks_word, M = $(g "$magnitude" 4); slip from the sample at t = $(g "$t_before") s to the one at t = $(g "$t_after") s"
+[ "$from_transitions" = 0 ] ||
+    title2="$ev_blocks $blocks_word, M = $(g "$magnitude" 4); slip from each block's first to its last transition in the event"
+# Square cells unless the lattice is long and thin (a chain): then the cells fill the frame.
+ratio="set size ratio -1"
+if [ $((rows * 4)) -lt "$cols" ] || [ $((cols * 4)) -lt "$rows" ]; then ratio="set size noratio"; fi
+tics() { if [ "$1" -le 16 ]; then echo "set $2tics 1"; else echo "set $2tics out; set m$2tics"; fi; }
+
+out="$outdir/${stem}_slip_map_$event.$format"
+# Drawn to a hidden file beside the figure, renamed when gnuplot succeeded.
+partial=$(mktemp "$outdir/.${stem}_slip_map_$event.XXXXXX") ||
+    fail "$outdir: cannot write there"
+gnuplot <<GP 2> "$tmp/gp.err" || fail "gnuplot failed drawing $out: $(cat "$tmp/gp.err")"
+set encoding utf8
+set terminal $terminal
+set output '$(gpq "$partial")'
+set title '$(gpq "$title1")' . "\n" . '$(gpq "$title2")'
+$ratio
+set xrange [-0.5 : $cols - 0.5]
+set yrange [$rows - 0.5 : -0.5]
+$(tics "$cols" x)
+$(tics "$rows" y)
+$( [ "$rows" -gt 1 ] || echo "set ytics (0)")
+set xlabel 'column (block i % $cols)'
+set ylabel 'row (block i / $cols)'
+set cbrange [$cb_range]
+set cblabel 'slip during the event [m]'
+# Room on the right for the colour box's label.
+set rmargin 18
+set palette defined (0 '#ffffe5', 0.15 '#fff7bc', 0.3 '#fee391', 0.45 '#fec44f', 0.6 '#fe9929', 0.75 '#ec7014', 0.88 '#cc4c02', 1 '#662506')
+set key outside below center horizontal
+$boxes
+plot '$tmp/slip.dat' using 1:2:3 with image notitle, \
+     $box_plot'-' using 1:2 with points pt 7 ps 2.2 lc rgb '#000000' notitle, \
+     '-' using 1:2 with points pt 7 ps 1.2 lc rgb '#17becf' title 'epicentre, block $first_block'
+$epi_c $epi_r
+e
+$epi_c $epi_r
+e
+GP
+# mktemp made it private; give it the mode a new file would have.
+chmod "$(printf %o $((0666 & ~0$(umask))))" "$partial" || true
+mv -f "$partial" "$out" || fail "cannot rename $partial to $out"
+partial=""
+echo "$out"
