@@ -13,7 +13,7 @@ case "$target" in
 esac
 
 packages=(build-essential pkg-config libsundials-dev libgsl-dev libhdf5-dev libcmocka-dev
-          libinih-dev liblapacke-dev gnuplot-nox time parallel procps)
+          libinih-dev liblapacke-dev hdf5-tools gnuplot-nox time parallel procps)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
