@@ -77,18 +77,24 @@ IFS=$'\t' read -r t_start t_end first_block ev_blocks left right _ _ magnitude _
     awk -F'\t' -v k="$event" '!/^#/ && n++ == k' "$tmp/events.tsv")
 
 # The lattice's shape (bksim info; its exit status says whether the run finished, which
-# does not matter here).  No lattice line: a chain, one row.
+# does not matter here): "lattice R x C blocks ...", or no such line for a chain, one row.
+# A lattice line that does not read so is an error, never a chain drawn in its place.
 info=$({ "$bksim" info "$file" 2>/dev/null || true; })
-shape=$(awk '$1 == "lattice" && $3 == "rows" {print $2, $5; exit}' <<<"$info")
-read -r rows cols <<<"${shape:-0 0}"
 n_blocks=$(awk '$1 == "n_blocks" {print $2; exit}' <<<"$info")
+[[ ${n_blocks:-} =~ ^[0-9]+$ ]] || fail "$file: bksim info gives no n_blocks"
+shape=$(awk '$1 == "lattice" {
+        print ($2 ~ /^[0-9]+$/ && $3 == "x" && $4 ~ /^[0-9]+$/) ? $2 " " $4 : "unreadable"; exit
+    }' <<<"$info")
+[ "$shape" != unreadable ] || fail "$file: cannot read the lattice's shape from bksim info: $(grep '^lattice' <<<"$info")"
+read -r rows cols <<<"${shape:-1 $n_blocks}"
+[ "$((rows * cols))" -eq "$n_blocks" ] || fail "$file: a $rows x $cols lattice of $n_blocks blocks"
 
 # A finished event's slip is exact from /transitions, where the run kept them: a block is
 # stuck between its episodes, so x at its last transition in the event minus x at its first
 # is all it slipped, and nothing else that moved between two sample rows counts.  They come
 # as two rows in the export's form (t_start, then t_end), so the map below takes either.
 from_transitions=0
-if [ "$complete" = 1 ] && [[ ${n_blocks:-} =~ ^[0-9]+$ ]] &&
+if [ "$complete" = 1 ] &&
    awk '$1 == "transitions" && $2 ~ /^[0-9]+$/ && $2 > 0 {found = 1} END {exit !found}' <<<"$info"; then
     from_transitions=1
 fi
@@ -129,7 +135,6 @@ awk -v ts="$t_start" -v te="$t_end" -v complete="$complete" -v cols="$cols" -v r
         nb = split(before, b, " "); na = split(after, a, " ")
         n = nb - 1
         if (na != nb || n < 1) exit 4
-        if (rows + 0 == 0) { rows = 1; cols = n }
         if (rows * cols != n) exit 5
         printf "%.17g %.17g %d %d %d %d\n", b[1], a[1], n, rows, cols, early > info
         # gnuplot images need 2 x 2 points: a single row or column is split in two halves.

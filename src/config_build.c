@@ -127,6 +127,11 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
                 }
             if (at && at->distribution && !block_note[0])
                 snprintf(block_note, sizeof block_note, " (drawn for block %zu)", i);
+            /* The other side of the conflict may be the drawn one (mu_d against a drawn mu_s). */
+            for (size_t q = 0; q < law->n_params && !block_note[0]; ++q)
+                if (origin[q] && origin[q]->distribution && q != (size_t)bad)
+                    snprintf(block_note, sizeof block_note, " (block %zu: %s drew %.17g from %s)", i,
+                             origin[q]->key, b->friction_params[q], origin[q]->value);
             if (at)
                 bk_config_report_entry(ld, at, "%s%s", msg, block_note);
             else
@@ -290,14 +295,15 @@ static size_t build_shape(loader *ld, size_t *rows, size_t *cols)
     return n;
 }
 
-/* A boundary key's value: its own entry, else `boundary`; on a chain (no rows key) the rows
- * direction is free unless boundary_rows is given. */
-static bk_boundary boundary_of(loader *ld, const char *key, int chain)
+/* A boundary key's value: its own entry, else `boundary` for a direction the lattice extends
+ * along, else free.  A single row's sides are the chain's ends, so a 1 x N lattice is the
+ * chain and an N x 1 one the chain stood on end, whichever keys gave the shape. */
+static bk_boundary boundary_of(loader *ld, const char *key, int extends)
 {
     entry *own = bk_config_lookup(ld, "model", key);
     if (own)
         return (bk_boundary)(int)own->number;
-    if (chain && strcmp(key, "boundary_rows") == 0)
+    if (!extends)
         return BK_BOUNDARY_FREE;
     return (bk_boundary)(int)value_of(ld, "model", "boundary");
 }
@@ -317,9 +323,8 @@ static void build_chain(loader *ld, bk_config *c)
     c->model = m;
     m->rows = rows;
     m->cols = cols;
-    int chain = bk_config_lookup(ld, "model", "rows") == NULL;
-    m->boundary_cols = boundary_of(ld, "boundary_cols", chain);
-    m->boundary_rows = boundary_of(ld, "boundary_rows", chain);
+    m->boundary_cols = boundary_of(ld, "boundary_cols", cols > 1 || rows == 1);
+    m->boundary_rows = boundary_of(ld, "boundary_rows", rows > 1);
     m->coupling_stiffness = value_of(ld, "model", "coupling_stiffness");
     m->coupling_damping = value_of(ld, "model", "coupling_damping");
     m->gravity = value_of(ld, "model", "gravity");

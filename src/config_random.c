@@ -124,15 +124,18 @@ double bk_config_draw(loader *ld, entry *e, size_t block, const bk_param *param)
         e->drawn++;
     }
     double x = e->last_draw;
-    if (!bk_param_in_range(param, x) && ld->error_rank == LONG_MAX) {
+    if (bk_param_in_range(param, x))
+        return x;
+    /* NaN even when an earlier error stands: an out-of-range draw must not go on to trip a
+     * cross-check (mu_d <= mu_s) that would be reported in its place. */
+    if (e->rank < ld->error_rank) {
         char allowed[1536];
         bk_config_format_allowed(NULL, param, allowed, sizeof allowed);
         bk_config_report_entry(ld, e, "%s drew %.17g for block %zu, outside the allowed range (allowed: %s; "
                                "narrow the distribution, or set that block in [%s.%zu])",
                                e->value, x, block, allowed, e->base, block);
-        return NAN;
     }
-    return x;
+    return NAN;
 }
 
 void bk_config_free_draws(entry *e)

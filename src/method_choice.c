@@ -30,7 +30,7 @@
  * worst); beyond, the worst case grows with N and the integrator is the safe default.  A
  * ring that slips all round is one cyclic cluster, dense and p^3 per restart (1e3 nearly
  * uniform blocks: 4.9 ms vs 0.37 ms per transition), so rings keep the earlier 100; so do
- * lattices, whose clusters are never tridiagonal either. */
+ * lattices of more than one row and column, whose clusters are never tridiagonal either. */
 #define AUTO_EXACT_MAX_BLOCKS 1000
 #define AUTO_EXACT_MAX_RING 100
 #define STIFF_RATIO 50.0
@@ -102,7 +102,11 @@ const char *bk_choose_method(const bk_config *config, const bk_scene *scene)
     if (strcmp(config->solver.method, "auto") != 0)
         return config->solver.method;
     const bk_model *m = config->model;
-    int dense_clusters = m->boundary_cols == BK_BOUNDARY_PERIODIC || bk_model_directions(m) > 2;
+    /* A single row or column is a chain (walls beside it only stiffen the diagonal); its
+     * clusters are tridiagonal unless it closes into a ring. */
+    int line = m->rows == 1 || m->cols == 1;
+    bk_boundary along = m->rows == 1 ? m->boundary_cols : m->boundary_rows;
+    int dense_clusters = !line || along == BK_BOUNDARY_PERIODIC;
     size_t exact_max = dense_clusters ? AUTO_EXACT_MAX_RING : AUTO_EXACT_MAX_BLOCKS;
     if (scene->affine && scene->n <= exact_max)
         return "exact";

@@ -23,6 +23,8 @@
 /* The damped single block: measured worst 24 rtol (cvode_bdf at zeta 0.7), the Runge-Kutta
  * back-ends below 1.2 rtol. */
 #define DAMPED_TIME_FACTOR 60.0
+/* The heterogeneous lattice against the exact stepper, absolute (transitions at 0.06-0.6 s). */
+#define LATTICE_TIME_S 1e-6
 
 static void run_config(bk_config *c, recorder *r, bk_run_stats *stats)
 {
@@ -209,6 +211,84 @@ static void test_uniform_lattice(void **state)
         bk_config_free(c);
     }
     exact_free(&ex);
+}
+
+/* A heterogeneous 3 x 4 lattice (walls above and below, periodic columns, random start and
+ * mu_d): its coupling forces are all non-zero, unlike the uniform lattice's.  The exact
+ * stepper is the reference; every integrator, and the implicit ones with a band solver too,
+ * gives its transitions block for block and mode for mode, each within LATTICE_TIME_S, and
+ * closes the energy audit. */
+static void heterogeneous_lattice(const char *method, const char *linear_solver, const recorder *reference,
+                                  recorder *out)
+{
+    const double rtol = 1e-10;
+    scene_spec spec = paper_case(0.5, BK_SPRING_LINEAR, rtol, method);
+    spec.n = 12;
+    spec.coupling = 2e4;
+    spec.t_end = 0.6;
+    bk_config *c = scene_config(&spec);
+    c->model->rows = 3;
+    c->model->cols = 4;
+    c->model->boundary_rows = BK_BOUNDARY_FIXED;
+    c->model->boundary_cols = BK_BOUNDARY_PERIODIC;
+    snprintf(c->solver.linear_solver, sizeof c->solver.linear_solver, "%s", linear_solver);
+    for (size_t i = 0; i < spec.n; ++i) {
+        c->model->blocks[i].x_init = 5e-4 + 1e-5 * sin(2.385 * (double)i);
+        c->model->blocks[i].friction_params[1] = 0.45 + 0.01 * (double)(i % 5);
+    }
+    bk_run_stats stats;
+    run_config(c, out, &stats);
+    double worst = 0.0;
+    if (reference) {
+        if (out->n_transitions != reference->n_transitions)
+            print_error("%s: %zu transitions, exact %zu\n", method, out->n_transitions, reference->n_transitions);
+        assert_int_equal(out->n_transitions, reference->n_transitions);
+        for (size_t k = 0; k < reference->n_transitions; ++k) {
+            const bk_transition *a = &out->transitions[k], *b = &reference->transitions[k];
+            assert_int_equal(a->block, b->block);
+            assert_int_equal(a->from, b->from);
+            assert_int_equal(a->to, b->to);
+            worst = fmax(worst, fabs(a->t - b->t));
+        }
+    }
+    row(method, linear_solver[0] == 'b' ? "3x4 band" : "3x4", rtol, &stats, "dt s", worst);
+    assert_true(worst <= LATTICE_TIME_S);
+    assert_true(fabs(stats.energy_residual) <= ENERGY_FACTOR * rtol);
+    bk_config_free(c);
+}
+
+static void test_heterogeneous_lattice(void **state)
+{
+    (void)state;
+    header();
+    recorder reference = {0};
+    heterogeneous_lattice("exact", "dense", NULL, &reference);
+    /* Blocks slip more than once each, and at some moment two that are neighbours up and
+     * down (a 2D island, coupled across rows) slip together. */
+    assert_true(reference.n_transitions > 4 * 12);
+    int slipping[12] = {0}, vertical = 0;
+    for (size_t k = 0; k < reference.n_transitions; ++k) {
+        const bk_transition *tr = &reference.transitions[k];
+        slipping[tr->block] = tr->to != BK_MODE_STICK;
+        for (int i = 0; i < 8; ++i)
+            vertical |= slipping[i] && slipping[i + 4];
+    }
+    print_message("%zu transitions; a 2D island: %s\n", reference.n_transitions, vertical ? "yes" : "no");
+    assert_true(vertical);
+    for (const bk_solver_backend *const *b = bk_solver_backends(); *b; ++b) {
+        if (strcmp((*b)->name, "exact") == 0)
+            continue;
+        recorder r = {0};
+        heterogeneous_lattice((*b)->name, "dense", &reference, &r);
+        recorder_free(&r);
+    }
+    const char *implicit[] = {"cvode_bdf", "arkode_dirk", "arkode_imex", "ida"};
+    for (size_t k = 0; k < sizeof implicit / sizeof implicit[0]; ++k) {
+        recorder r = {0};
+        heterogeneous_lattice(implicit[k], "band", &reference, &r);
+        recorder_free(&r);
+    }
+    recorder_free(&reference);
 }
 
 /* --- the damped single block against its closed form ----------------------------------- */
@@ -822,6 +902,7 @@ int main(void)
         cmocka_unit_test(test_cases_a_b),
         cmocka_unit_test(test_case_c),
         cmocka_unit_test(test_uniform_lattice),
+        cmocka_unit_test(test_heterogeneous_lattice),
         cmocka_unit_test(test_damped_single_block),
         cmocka_unit_test(test_driver_history),
         cmocka_unit_test(test_chain_energy),

@@ -150,6 +150,25 @@ static void test_lattice_extent(void **state)
     assert_int_equal(e[1].left, 0);
     assert_int_equal(e[1].right, 1 * 5 + 4);
     bk_catalog_free(c);
+    /* A torus: rows wrap too.  (3, 1), (0, 1), (0, 2): rows 3 round to 0, columns 1..2; and
+     * (0, 0), (2, 0): rows 0..2 either way round on 4 rows, the first arc kept (no wrap). */
+    c = bk_catalog_create_lattice(4, 5, 1, 1, 0.0);
+    const bk_transition torus[] = {
+        tr(1.0, 16, STICK, SLIP, 0.0, 1.0), tr(1.1, 1, STICK, SLIP, 0.0, 1.0),
+        tr(1.1, 2, STICK, SLIP, 0.0, 1.0), tr(1.2, 16, SLIP, STICK, 0.1, 0.0),
+        tr(1.2, 1, SLIP, STICK, 0.1, 0.0), tr(1.2, 2, SLIP, STICK, 0.1, 0.0),
+        tr(2.0, 0, STICK, SLIP, 0.0, 1.0), tr(2.0, 10, STICK, SLIP, 0.0, 1.0),
+        tr(2.1, 0, SLIP, STICK, 0.1, 0.0), tr(2.1, 10, SLIP, STICK, 0.1, 0.0),
+        tr(3.0, 12, STICK, SLIP, 0.0, 1.0),
+    };
+    assert_int_equal(feed(c, torus, sizeof torus / sizeof *torus, e), 2);
+    assert_int_equal(e[0].n_blocks, 3);
+    assert_int_equal(e[0].left, 3 * 5 + 1); /* left's row 3 > right's row 0: wraps */
+    assert_int_equal(e[0].right, 0 * 5 + 2);
+    assert_int_equal(e[1].n_blocks, 2);
+    assert_int_equal(e[1].left, 0);
+    assert_int_equal(e[1].right, 2 * 5 + 0);
+    bk_catalog_free(c);
 }
 
 /* Blocks slipping at the start open an event; one still running at the end of the run is

@@ -188,34 +188,50 @@ typedef struct bad_case {
 } bad_case;
 
 /* A chain as a 1 x N lattice, and as an N x 1 one (coupled up and down instead of left and
- * right), writes the chain's output bit for bit: free ends (bk10_coulomb), fixed walls, and
- * a ring with a system-size event at 91 s (carlson_langer_100). */
+ * right), writes the chain's output bit for bit, with the chain's own `boundary` key and
+ * method = auto choosing alike: free ends (bk10_coulomb), fixed walls, a ring with a
+ * system-size event at 91 s (carlson_langer_100), and 1000 blocks that auto gives the
+ * exact stepper (bk1000_coulomb). */
 static void test_lattice_of_one_line_is_a_chain(void **state)
 {
     (void)state;
-    static const struct {
-        const char *config, *extra, *boundary;
-    } chains[] = {
-        {"configs/chains/bk10_coulomb.ini", "--set run.t_end=4", "free"},
-        {"configs/chains/bk10_coulomb.ini", "--set run.t_end=4 --set model.boundary=fixed", "fixed"},
+    static const char *const chains[][2] = {
+        {"configs/chains/bk10_coulomb.ini", "--set run.t_end=4"},
+        {"configs/chains/bk10_coulomb.ini", "--set run.t_end=4 --set model.boundary=fixed"},
         {"configs/chains/carlson_langer_100.ini",
-         "--set run.t_end=120 --set output.transitions=true --set output.interval=0.5", "periodic"},
+         "--set run.t_end=120 --set output.transitions=true --set output.interval=0.5"},
+        {"configs/chains/bk1000_coulomb.ini", "--set run.t_end=0.5"},
     };
     char chain[600], lattice[600], cmd[2048];
+    char *chain_info = NULL, *lattice_info = NULL;
     for (size_t k = 0; k < sizeof chains / sizeof chains[0]; ++k) {
         snprintf(chain, sizeof chain, "%s/line_chain.h5", tmpdir);
-        snprintf(cmd, sizeof cmd, "./bksim run %s %s -o %s --quiet --force", chains[k].config, chains[k].extra, chain);
+        snprintf(cmd, sizeof cmd, "./bksim run %s %s -o %s --quiet --force", chains[k][0], chains[k][1], chain);
         assert_int_equal(run_command(cmd, NULL), 0);
+        snprintf(cmd, sizeof cmd, "./bksim info %s", chain);
+        assert_int_equal(run_command(cmd, &chain_info), 0);
         for (int column = 0; column < 2; ++column) {
             snprintf(lattice, sizeof lattice, "%s/line_lattice.h5", tmpdir);
             /* n_blocks stays as the chain gives it: the other dimension follows. */
-            snprintf(cmd, sizeof cmd, "./bksim run %s %s --set model.%s=1 --set model.boundary_rows=%s "
-                     "--set model.boundary_cols=%s -o %s --quiet --force", chains[k].config, chains[k].extra,
-                     column ? "cols" : "rows", column ? chains[k].boundary : "free",
-                     column ? "free" : chains[k].boundary, lattice);
+            snprintf(cmd, sizeof cmd, "./bksim run %s %s --set model.%s=1 -o %s --quiet --force", chains[k][0],
+                     chains[k][1], column ? "cols" : "rows", lattice);
             assert_int_equal(run_command(cmd, NULL), 0);
             assert_same_output(chain, lattice);
+            snprintf(cmd, sizeof cmd, "./bksim info %s", lattice);
+            assert_int_equal(run_command(cmd, &lattice_info), 0);
+            /* The stats' method line ("exact (auto)"), after the config's own "method = auto". */
+            const char *method = strstr(chain_info, "    method   "), *same = strstr(lattice_info, "    method   ");
+            assert_non_null(method);
+            assert_non_null(same);
+            assert_memory_equal(same, method, (size_t)(strchr(method, '\n') - method));
+            if (column && k == 0)
+                assert_non_null(strstr(lattice_info, "lattice      10 x 1 blocks (block i at lattice row i / 1, "
+                                                     "column i % 1)\n"));
+            free(lattice_info);
+            lattice_info = NULL;
         }
+        free(chain_info);
+        chain_info = NULL;
     }
 }
 
@@ -1295,8 +1311,12 @@ static void test_catalog_scripts(void **state)
     snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh --format svg --event 0 -o %s/fig %s/sheet.h5", bin,
              tmpdir, tmpdir);
     assert_int_equal(run_command(cmd, NULL), 0);
-    snprintf(cmd, sizeof cmd, "%s/fig/sheet_slip_map_0.svg", tmpdir);
-    assert_true(path_exists(cmd));
+    /* Drawn as the 4 x 5 lattice it is, never as a strip of 20. */
+    snprintf(cmd, sizeof cmd, "grep -c -e '>row (block i / 5)<' -e '>column (block i %% 5)<' %s/fig/sheet_slip_map_0.svg",
+             tmpdir);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_string_equal(text, "2\n");
+    free(text);
     snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh --event 99999 -o %s/fig %s/sheet.h5", bin, tmpdir,
              tmpdir);
     expect_command(cmd, 1, "out of range");

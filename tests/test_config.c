@@ -371,6 +371,45 @@ static void variant(char *out, size_t len, const char *line, const char *replace
              at + strlen(line));
 }
 
+/* The lattice's shape from any two of n_blocks, rows and cols, and `boundary` on each
+ * direction the lattice extends along, whichever keys gave the shape: one row is the chain
+ * (no walls above and below), one column the chain stood on end. */
+static void test_lattice_shape_and_boundaries(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *model;
+        size_t rows, cols;
+        bk_boundary boundary_rows, boundary_cols;
+    } cases[] = {
+        {"n_blocks = 12\nboundary = fixed\n", 1, 12, BK_BOUNDARY_FREE, BK_BOUNDARY_FIXED},
+        {"n_blocks = 12\nrows = 1\nboundary = fixed\n", 1, 12, BK_BOUNDARY_FREE, BK_BOUNDARY_FIXED},
+        {"n_blocks = 12\ncols = 4\nboundary = fixed\n", 3, 4, BK_BOUNDARY_FIXED, BK_BOUNDARY_FIXED},
+        {"rows = 3\ncols = 4\nboundary = periodic\n", 3, 4, BK_BOUNDARY_PERIODIC, BK_BOUNDARY_PERIODIC},
+        {"n_blocks = 12\ncols = 1\nboundary = periodic\n", 12, 1, BK_BOUNDARY_PERIODIC, BK_BOUNDARY_FREE},
+        {"n_blocks = 1\nboundary = fixed\n", 1, 1, BK_BOUNDARY_FREE, BK_BOUNDARY_FIXED},
+        {"n_blocks = 12\nrows = 1\nboundary = fixed\nboundary_rows = periodic\n", 1, 12, BK_BOUNDARY_PERIODIC,
+         BK_BOUNDARY_FIXED},
+        {"n_blocks = 12\ncols = 1\nboundary_cols = fixed\n", 12, 1, BK_BOUNDARY_FREE, BK_BOUNDARY_FIXED},
+        {"rows = 2\ncols = 6\nboundary = fixed\nboundary_cols = periodic\n", 2, 6, BK_BOUNDARY_FIXED,
+         BK_BOUNDARY_PERIODIC},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        char text[1024];
+        variant(text, sizeof text, "n_blocks = 1\n", cases[k].model);
+        bk_config *c = NULL;
+        bk_error err = {0};
+        if (bk_config_load_string(text, "t.ini", NULL, 0, &c, &err) != BK_OK)
+            fail_msg("case %zu: %s", k, err.message);
+        assert_int_equal(c->model->n_blocks, cases[k].rows * cases[k].cols);
+        assert_int_equal(c->model->rows, cases[k].rows);
+        assert_int_equal(c->model->cols, cases[k].cols);
+        assert_int_equal(c->model->boundary_rows, cases[k].boundary_rows);
+        assert_int_equal(c->model->boundary_cols, cases[k].boundary_cols);
+        bk_config_free(c);
+    }
+}
+
 typedef struct rejection {
     const char *line, *replacement, *message;
 } rejection;
@@ -481,6 +520,9 @@ static void test_rejections(void **state)
         {"mu_d = 0.5\n", "mu_d = uniform(0.7, 0.8)\n",
          "t.ini:9: [friction] mu_d: must be <= mu_s (0.6), got 0.7"},
         {"mu_d = 0.5\n", "mu_d = uniform(0.7, 0.8)\n", "(drawn for block 0)"},
+        {"mu_s = 0.6\n", "mu_s = uniform(0.3, 0.4)\n", "t.ini:9: [friction] mu_d: must be <= mu_s (0.3"},
+        {"mu_s = 0.6\n", "mu_s = uniform(0.3, 0.4)\n", "(block 0: mu_s drew 0.3"},
+        {"mu_s = 0.6\n", "mu_s = uniform(0.3, 0.4)\n", " from uniform(0.3, 0.4))"},
         /* Driver histories. */
         {"velocity = 1e-3\n", "velocities = 1e-3, 0, 2e-3\ndurations = 1, 2\n",
          "t.ini:12: [driver] durations: has 2 values, velocities has 3 (allowed: one duration per velocity)"},
@@ -541,6 +583,23 @@ static void test_first_error_reported(void **state)
     bk_error err = {0};
     assert_int_equal(bk_config_load_string(both, "t.ini", NULL, 0, &c, &err), BK_ERR_CONFIG);
     assert_non_null(strstr(err.message, "t.ini:4: [block] mass"));
+}
+
+/* A draw outside its key's range stays the error: the value must not go on into a law's
+ * cross-check that an earlier line (mu_d) would report in its place. */
+static void test_out_of_range_draw_stays_the_error(void **state)
+{
+    (void)state;
+    char text[1024];
+    snprintf(text, sizeof text, "%s", minimal_config);
+    strstr(text, "n_blocks = 1")[11] = '4';
+    const char *overrides[] = {"friction.mu_s=normal(-1, 0.01)"};
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(text, "t.ini", overrides, 1, &c, &err), BK_ERR_CONFIG);
+    assert_null(c);
+    assert_non_null(strstr(err.message, "--set friction.mu_s=normal(-1, 0.01): [friction] mu_s: normal(-1, 0.01) drew -"));
+    assert_non_null(strstr(err.message, " for block 0, outside the allowed range"));
 }
 
 static void test_overrides(void **state)
@@ -781,6 +840,7 @@ int main(void)
         cmocka_unit_test(test_full_config),
         cmocka_unit_test(test_damping_keys),
         cmocka_unit_test(test_driver_history_keys),
+        cmocka_unit_test(test_lattice_shape_and_boundaries),
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(test_checkpoint_keys),
         cmocka_unit_test(test_distributions),
@@ -788,6 +848,7 @@ int main(void)
         cmocka_unit_test(test_tolerated_forms),
         cmocka_unit_test(test_rejections),
         cmocka_unit_test(test_first_error_reported),
+        cmocka_unit_test(test_out_of_range_draw_stays_the_error),
         cmocka_unit_test(test_overrides),
         cmocka_unit_test(test_file_errors),
         cmocka_unit_test(test_per_block_friction),

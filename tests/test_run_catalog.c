@@ -114,8 +114,8 @@ static double force_at(const void *user, size_t i)
 static bk_event *rebuild(const bk_config *c, const catalog_sink *s, size_t *count)
 {
     const bk_model *m = c->model;
-    bk_catalog *b = bk_catalog_create(m->n_blocks, m->boundary_cols == BK_BOUNDARY_PERIODIC,
-                                      c->catalog.magnitude_offset);
+    bk_catalog *b = bk_catalog_create_lattice(m->rows, m->cols, m->boundary_rows == BK_BOUNDARY_PERIODIC,
+                                              m->boundary_cols == BK_BOUNDARY_PERIODIC, c->catalog.magnitude_offset);
     assert_non_null(b);
     bk_event *out = calloc(s->n_transitions + 2, sizeof *out);
     size_t n = 0;
@@ -145,20 +145,24 @@ static void expect_rebuilt(const bk_config *c, const catalog_sink *s)
 }
 
 /* Done-when 1: the 1,000-block chain shipped in configs/, with the exact stepper and with an
- * integrator, and the 1,000-block Carlson-Langer ring. */
+ * integrator, the 1,000-block Carlson-Langer ring, and a lattice. */
 static void test_chain_1000_matches_rebuild(void **state)
 {
     (void)state;
     static const char *const exact[] = {"run.t_end=1", "output.interval=0"};
     static const char *const rk[] = {"run.t_end=0.5", "output.interval=0", "solver.method=gsl_rk8pd"};
     static const char *const ring[] = {"run.t_end=100", "output.interval=0", "output.transitions=true"};
+    /* A 12 x 12 torus of random strength: bounding boxes that wrap round both directions. */
+    static const char *const torus[] = {"model.rows=12", "model.cols=12", "model.boundary=periodic",
+                                        "driver.velocity=1e-5", "run.t_end=62"};
     struct {
         const char *path;
         const char *const *overrides;
         size_t n;
     } runs[] = {{"configs/chains/bk1000_coulomb.ini", exact, 2},
                 {"configs/chains/bk1000_coulomb.ini", rk, 3},
-                {"configs/chains/carlson_langer_1000.ini", ring, 3}};
+                {"configs/chains/carlson_langer_1000.ini", ring, 3},
+                {"configs/lattices/lattice_64x64.ini", torus, 5}};
     for (size_t r = 0; r < sizeof runs / sizeof runs[0]; ++r) {
         bk_config *c = load(runs[r].path, 1, runs[r].overrides, runs[r].n);
         catalog_sink s = {0};
@@ -170,6 +174,13 @@ static void test_chain_1000_matches_rebuild(void **state)
         for (size_t k = 0; k < s.n_events; ++k)
             largest = s.events[k].n_blocks > s.events[largest].n_blocks ? k : largest;
         assert_true(s.events[largest].n_blocks > 10); /* not only single-block events */
+        if (c->model->rows > 1) {
+            size_t wrapped = 0;
+            for (size_t k = 0; k < s.n_events; ++k)
+                wrapped += s.events[k].left > s.events[k].right;
+            print_message("%zu events' boxes wrap round an edge\n", wrapped);
+            assert_true(wrapped > 0);
+        }
         sink_free(&s);
         bk_config_free(c);
     }

@@ -389,8 +389,8 @@ int bk_h5_info_blocks(const char *path, FILE *out, int per_block, bk_error *err)
     long long lattice_rows = 1, lattice_cols = n_blocks;
     if (bk_h5_read_numeric_attr(file, "rows", H5T_NATIVE_LLONG, &lattice_rows) >= 0 &&
         bk_h5_read_numeric_attr(file, "cols", H5T_NATIVE_LLONG, &lattice_cols) >= 0 && lattice_rows > 1)
-        fprintf(out, "lattice      %lld rows x %lld cols (block i at row i / cols, column i %% cols)\n", lattice_rows,
-                lattice_cols);
+        fprintf(out, "lattice      %lld x %lld blocks (block i at lattice row i / %lld, column i %% %lld)\n",
+                lattice_rows, lattice_cols, lattice_cols, lattice_cols);
     if (have_rows)
         fprintf(out, "rows         %llu\n", (unsigned long long)rows);
     else
