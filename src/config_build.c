@@ -17,6 +17,8 @@
 
 static void report_missing(loader *ld, const char *section, const bk_param *param, const key_def *def)
 {
+    if (RANK_MISSING >= ld->error_rank)
+        return; /* an earlier error stands: skip formatting, once per block of a long chain */
     char allowed[1536];
     bk_config_format_allowed(def, param, allowed, sizeof allowed);
     bk_config_report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [%s] %s: required key missing (allowed: %s)", ld->name,
@@ -42,14 +44,13 @@ static double value_of(loader *ld, const char *section, const char *key)
 }
 
 /* A block key: [block.I] over [block] over the default; a distribution draws block i's. */
-static double block_value(loader *ld, size_t i, const char *key, int *given)
+static double block_value(loader *ld, size_t i, const key_def *def, int *given)
 {
-    char section[SECTION_LEN];
-    snprintf(section, sizeof section, "block.%zu", i);
-    entry *e = bk_config_lookup(ld, section, key);
+    const bk_param *param = &def->param;
+    const char *key = param->key;
+    entry *e = bk_config_lookup_block(ld, "block", i, key);
     if (!e)
         e = bk_config_lookup(ld, "block", key);
-    const bk_param *param = &bk_config_find_key("block", key)->param;
     *given = e != NULL;
     double value = !e ? param->default_value : e->distribution ? bk_config_draw(ld, e, i, param) : e->number;
     bk_config_record_parameter(ld, "block", key, param->unit, i, value);
@@ -61,7 +62,7 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
 {
     char section[SECTION_LEN];
     snprintf(section, sizeof section, "friction.%zu", i);
-    entry *own_law = bk_config_lookup(ld, section, "law");
+    entry *own_law = bk_config_lookup_block(ld, "friction", i, "law");
     entry *base_law = bk_config_lookup(ld, "friction", "law");
     entry *law_entry = own_law ? own_law : base_law;
     if (!law_entry) {
@@ -79,7 +80,7 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
     b->law = law;
     for (size_t p = 0; p < law->n_params; ++p) {
         const bk_param *param = &law->params[p];
-        entry *e = bk_config_lookup(ld, section, param->key);
+        entry *e = bk_config_lookup_block(ld, "friction", i, param->key);
         if (!e && inherit)
             e = bk_config_lookup(ld, "friction", param->key);
         origin[p] = e;
@@ -106,7 +107,13 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
                 return;
             }
     }
-    if (law->validate) {
+    /* Once an error stands that no conflict of this block could precede, a long chain's
+     * blocks skip formatting a message that would be dropped (1e6 of them took seconds). */
+    long earliest = RANK_MISSING;
+    for (size_t p = 0; p < law->n_params; ++p)
+        if (origin[p] && origin[p]->rank < earliest)
+            earliest = origin[p]->rank;
+    if (law->validate && earliest < ld->error_rank) {
         char msg[256];
         int bad = law->validate(b->friction_params, msg, sizeof msg);
         entry *at = bad >= 0 ? origin[bad] : NULL;
@@ -169,9 +176,7 @@ static void check_initial_energy(loader *ld, const bk_model *m)
             key = "x_init";
         if (!key)
             continue;
-        char section[SECTION_LEN];
-        snprintf(section, sizeof section, "block.%zu", i);
-        entry *e = bk_config_lookup(ld, section, key);
+        entry *e = bk_config_lookup_block(ld, "block", i, key);
         if (!e)
             e = bk_config_lookup(ld, "block", key);
         if (!e)
@@ -331,7 +336,13 @@ static void build_chain(loader *ld, bk_config *c)
     m->spring = (bk_spring)(int)value_of(ld, "driver", "spring");
     double history = build_driver(ld, m);
 
-    static const char *const required[] = {"mass", "driver_stiffness"};
+    /* The block keys' definitions, looked up once rather than per block. */
+    enum { MASS, DRIVER_STIFFNESS, NORMAL_FORCE, X_INIT, X_INIT_RANDOM, V_INIT, DAMPING, N_BLOCK_KEYS };
+    static const char *const block_keys[N_BLOCK_KEYS] = {"mass", "driver_stiffness", "normal_force", "x_init",
+                                                         "x_init_random", "v_init", "damping"};
+    const key_def *def[N_BLOCK_KEYS];
+    for (size_t k = 0; k < N_BLOCK_KEYS; ++k)
+        def[k] = bk_config_find_key("block", block_keys[k]);
     if (bk_config_plan_parameters(ld, n) != 0)
         return;
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
@@ -343,17 +354,16 @@ static void build_chain(loader *ld, bk_config *c)
     for (size_t i = 0; i < n; ++i) {
         bk_block *b = &m->blocks[i];
         int given;
-        for (size_t r = 0; r < 2; ++r) {
-            double value = block_value(ld, i, required[r], &given);
+        for (size_t r = MASS; r <= DRIVER_STIFFNESS; ++r) {
+            double value = block_value(ld, i, def[r], &given);
             if (!given)
-                report_missing(ld, "block", &bk_config_find_key("block", required[r])->param,
-                               bk_config_find_key("block", required[r]));
-            if (r == 0)
+                report_missing(ld, "block", &def[r]->param, def[r]);
+            if (r == MASS)
                 b->mass = value;
             else
                 b->driver_stiffness = value;
         }
-        b->normal_force = block_value(ld, i, "normal_force", &given);
+        b->normal_force = block_value(ld, i, def[NORMAL_FORCE], &given);
         if (!given)
             b->normal_force = b->mass * m->gravity;
         if (!isfinite(b->normal_force) && ld->error_rank == LONG_MAX) {
@@ -361,11 +371,11 @@ static void build_chain(loader *ld, bk_config *c)
                              "overflows (%g kg * %g m/s^2; allowed: 0 < normal_force < inf N)", ld->name, i, b->mass, m->gravity);
             break;
         }
-        b->x_init = block_value(ld, i, "x_init", &given);
+        b->x_init = block_value(ld, i, def[X_INIT], &given);
         /* Drawn for every block, so a block's value does not depend on its neighbours' keys. */
-        b->x_init += block_value(ld, i, "x_init_random", &given) * (2.0 * gsl_rng_uniform(rng) - 1.0);
-        b->v_init = block_value(ld, i, "v_init", &given);
-        b->damping = block_value(ld, i, "damping", &given);
+        b->x_init += block_value(ld, i, def[X_INIT_RANDOM], &given) * (2.0 * gsl_rng_uniform(rng) - 1.0);
+        b->v_init = block_value(ld, i, def[V_INIT], &given);
+        b->damping = block_value(ld, i, def[DAMPING], &given);
         build_friction(ld, b, i, m->driver.velocity);
         if (ld->error_rank != LONG_MAX && ld->error_rank >= RANK_MISSING)
             break; /* one missing key is enough; don't repeat it for every block */
@@ -460,9 +470,9 @@ static void build_prescribed(loader *ld, bk_config *c)
         return;
     bk_block *b = &m->blocks[0];
     int given_mass, given_normal;
-    double mass = block_value(ld, 0, "mass", &given_mass);
+    double mass = block_value(ld, 0, bk_config_find_key("block", "mass"), &given_mass);
     b->mass = given_mass ? mass : 1.0;
-    b->normal_force = block_value(ld, 0, "normal_force", &given_normal);
+    b->normal_force = block_value(ld, 0, bk_config_find_key("block", "normal_force"), &given_normal);
     if (!given_normal)
         b->normal_force = given_mass ? b->mass * m->gravity : 1.0;
     build_friction(ld, b, 0, first_rate);

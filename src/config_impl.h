@@ -73,6 +73,7 @@ typedef struct loader {
      * and a config with many [block.I] sections loads in linear time. */
     size_t *slots;             /* entry index + 1, 0 for an empty slot */
     size_t n_slots;            /* a power of two, at least twice the entries */
+    int per_block_sections;    /* any [block.I] or [friction.I] entry: else blocks skip those lookups */
     unsigned long seed;        /* [model] seed, once building begins */
     bk_block_parameter *parameters; /* keys given as a distribution, until the config takes them */
     size_t n_parameters;
@@ -93,6 +94,8 @@ int bk_config_add_entry(loader *ld, const char *section, const char *key, const 
 char *bk_config_read_line(char *str, int num, void *stream);
 int bk_config_on_pair(void *user, const char *section, const char *key, const char *value);
 int bk_config_build_index(loader *ld);
+/* The entry of [base.i] key, or NULL; O(1) without formatting when no such section exists. */
+entry *bk_config_lookup_block(loader *ld, const char *base, size_t i, const char *key);
 entry *bk_config_lookup(loader *ld, const char *section, const char *key);
 int bk_config_check_value(loader *ld, entry *e, const key_def *def, const bk_param *param);
 void bk_config_check_entries(loader *ld, long n_blocks);

@@ -403,6 +403,7 @@ int bk_config_build_index(loader *ld)
             e->first_of_key = earlier->first_of_key >= 0 ? earlier->first_of_key : (long)(*slot - 1);
         }
         *slot = i + 1;
+        ld->per_block_sections |= e->index >= 0;
     }
     return 0;
 }
@@ -412,6 +413,15 @@ entry *bk_config_lookup(loader *ld, const char *section, const char *key)
 {
     size_t slot = *find_slot(ld, section, key);
     return slot ? &ld->entries[slot - 1] : NULL;
+}
+
+entry *bk_config_lookup_block(loader *ld, const char *base, size_t i, const char *key)
+{
+    if (!ld->per_block_sections)
+        return NULL;
+    char section[SECTION_LEN];
+    snprintf(section, sizeof section, "%s.%zu", base, i);
+    return bk_config_lookup(ld, section, key);
 }
 
 /* --- checks ----------------------------------------------------------------------------- */
