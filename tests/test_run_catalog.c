@@ -152,7 +152,7 @@ static void test_chain_1000_matches_rebuild(void **state)
     static const char *const exact[] = {"run.t_end=1", "output.interval=0"};
     static const char *const rk[] = {"run.t_end=0.5", "output.interval=0", "solver.method=gsl_rk8pd"};
     static const char *const ring[] = {"run.t_end=100", "output.interval=0", "output.transitions=true"};
-    /* A 12 x 12 torus of random strength: bounding boxes that wrap round both directions. */
+    /* A 12 x 12 torus of random strength: bounding boxes that wrap round its edges. */
     static const char *const torus[] = {"model.rows=12", "model.cols=12", "model.boundary=periodic",
                                         "driver.velocity=1e-5", "run.t_end=62"};
     struct {
