@@ -60,8 +60,6 @@ static double block_value(loader *ld, size_t i, const key_def *def, int *given)
 /* Friction of block i: its law and parameters, completed and validated. */
 static void build_friction(loader *ld, bk_block *b, size_t i, double driver_speed)
 {
-    char section[SECTION_LEN];
-    snprintf(section, sizeof section, "friction.%zu", i);
     entry *own_law = bk_config_lookup_block(ld, "friction", i, "law");
     entry *base_law = bk_config_lookup(ld, "friction", "law");
     entry *law_entry = own_law ? own_law : base_law;
@@ -75,7 +73,7 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
         return; /* reported at its line */
     /* Parameters of [friction] apply unless this block names a different law. */
     int inherit = !own_law || (base_law && strcmp(own_law->value, base_law->value) == 0);
-    const char *param_section = own_law ? section : "friction";
+    const char *param_section = own_law ? own_law->section : "friction";
     entry *origin[BK_FRICTION_MAX_PARAMS] = {0};
     b->law = law;
     for (size_t p = 0; p < law->n_params; ++p) {
@@ -120,15 +118,15 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
         /* The same conflict in every block of a long chain is reported once: only an
          * earlier-ranked one is worth the message. */
         if (bad >= 0 && !(at && at->rank >= ld->error_rank)) {
-            /* A conflict with this block's own value is reported at the shared key: name the
-             * block and where its value came from. */
+            /* A conflict with this block's own value (from its [friction.I], index >= 0) is
+             * reported at the shared key: name the block and where its value came from. */
             char block_note[640] = "";
-            for (size_t q = 0; q < law->n_params && (!at || strcmp(at->section, section) != 0); ++q)
-                if (origin[q] && strcmp(origin[q]->section, section) == 0) {
+            for (size_t q = 0; q < law->n_params && (!at || at->index < 0); ++q)
+                if (origin[q] && origin[q]->index >= 0) {
                     char where[512];
                     bk_config_location(ld, origin[q], where, sizeof where);
                     if (snprintf(block_note, sizeof block_note, " (block %zu: %s sets [%s] %s = %s)", i,
-                                 where, section, origin[q]->key, origin[q]->value) < 0)
+                                 where, origin[q]->section, origin[q]->key, origin[q]->value) < 0)
                         block_note[0] = '\0';
                     break;
                 }
