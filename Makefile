@@ -84,13 +84,15 @@ test-slurm: bksim
 	scripts/test_slurm.sh
 
 # Static analysis (options and suppressions in tests/cppcheck.cfg), then the library's
-# namespace: every symbol libbksim.a exports starts with bk_.
+# namespace (every symbol libbksim.a exports starts with bk_) and its layers (no two files
+# call each other, directly or round a circle: scripts/lint_calls.sh).
 lint: build/libbksim.a
 	cppcheck $$(cat tests/cppcheck.cfg) -Iinclude -Isrc -Itests/support src tests/*.c tests/support/*.c \
 	    tests/fuzz/*.c bench/*.c
 	@bad=$$(nm -g --defined-only build/libbksim.a | awk 'NF == 3 && $$3 !~ /^bk_/ {print $$3}'); \
 	 if [ -n "$$bad" ]; then echo "lint: symbols of libbksim.a without the bk_ prefix:" $$bad >&2; exit 1; fi; \
 	 echo "lint: every exported symbol of libbksim.a starts with bk_"
+	@scripts/lint_calls.sh $(call objs,build,$(LIB_SRC))
 
 paper: bksim
 	scripts/run_paper.sh

@@ -13,7 +13,7 @@
 
 #include <ini.h>
 
-#include "config_impl.h"
+#include "config_loader.h"
 
 #define MAX_FILE_BYTES (1 << 20)
 

@@ -12,8 +12,8 @@
 #include <gsl/gsl_rng.h>
 
 #include "bksim/solver.h"
-#include "config_impl.h"
-#include "output/layout.h"
+#include "config_loader.h"
+#include "layout.h"
 
 static void report_missing(loader *ld, const char *section, const bk_param *param, const key_def *def)
 {

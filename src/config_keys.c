@@ -8,8 +8,8 @@
 #include <string.h>
 
 #include "bksim/solver.h"
-#include "config_impl.h"
-#include "output/layout.h"
+#include "config_loader.h"
+#include "layout.h"
 
 
 

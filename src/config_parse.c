@@ -11,7 +11,6 @@
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,36 +18,12 @@
 #include <strings.h>
 
 #include "capacity.h"
-#include "config_impl.h"
-#include "output/layout.h"
+#include "config_loader.h"
+#include "layout.h"
 
 #define MAX_LINE_CHARS 190
 
 /* --- collected entries ------------------------------------------------------------------ */
-
-/* Record a failure at `rank` unless an earlier one is already recorded. */
-void bk_config_report(loader *ld, long rank, int status, const char *fmt, ...)
-{
-    if (rank >= ld->error_rank)
-        return;
-    ld->error_rank = rank;
-    ld->status = status;
-    char buf[BK_ERROR_MESSAGE_LEN];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
-    va_end(ap);
-    BK_FAIL(ld->err, status, "%s", buf);
-}
-
-/* "file:12" or "--set block.mass=0". */
-void bk_config_location(const loader *ld, const entry *e, char *buf, size_t len)
-{
-    if (e->override)
-        snprintf(buf, len, "--set %s", e->override);
-    else
-        snprintf(buf, len, "%s:%d", ld->name, e->line);
-}
 
 /* Where a section was opened: its header line, or the entry's own location. */
 static void section_location(const loader *ld, const entry *e, char *buf, size_t len)
@@ -57,19 +32,6 @@ static void section_location(const loader *ld, const entry *e, char *buf, size_t
         bk_config_location(ld, e, buf, len);
     else
         snprintf(buf, len, "%s:%d", ld->name, e->section_line);
-}
-
-void bk_config_report_entry(loader *ld, const entry *e, const char *fmt, ...)
-{
-    if (e->rank >= ld->error_rank)
-        return;
-    char where[512], what[1792];
-    bk_config_location(ld, e, where, sizeof where);
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(what, sizeof what, fmt, ap);
-    va_end(ap);
-    bk_config_report(ld, e->rank, BK_ERR_CONFIG, "%s: [%s] %s: %s", where, e->section, e->key, what);
 }
 
 /* Split "block.3" into base "block" and index 3; -1 for plain sections, -2 if malformed. */

@@ -14,7 +14,7 @@
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 
-#include "config_impl.h"
+#include "config_loader.h"
 
 static const char *const distribution_names[] = {"", "uniform", "normal", "lognormal"};
 

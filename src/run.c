@@ -29,46 +29,11 @@
 #include <gsl/gsl_errno.h>
 
 #include "method_choice.h"
-#include "output/layout.h"
+#include "layout.h"
 #include "prescribed.h"
-#include "run_impl.h"
+#include "run_ctx.h"
 
 #define PI 3.14159265358979323846
-
-double bk_run_wall_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-int bk_run_report_progress(run_ctx *ctx, double t)
-{
-    if (ctx->progress) {
-        bk_progress report = {
-            .t = ctx->t_progress = fmax(ctx->t_progress, t),
-            .t_end = ctx->t_end,
-            .t_resumed = ctx->t_resumed,
-            .transitions = ctx->stats->transitions,
-            .events = ctx->catalog ? ctx->events : -1,
-            .events_resumed = ctx->events_resumed,
-        };
-        if (ctx->progress(ctx->progress_user, &report) != 0)
-            return BK_FAIL(ctx->err, BK_ERR_INTERRUPTED, "run interrupted at t = %.17g s", t);
-    }
-    double limit = ctx->config->wall_time_limit;
-    if (limit > 0.0 && bk_run_wall_seconds() - ctx->wall_start > limit)
-        return BK_FAIL(ctx->err, BK_ERR_INTERRUPTED,
-                       "[run] wall_time_limit = %g s reached at t = %.17g s of %g s", limit, t, ctx->t_end);
-    return BK_OK;
-}
-
-double bk_run_checkpoint_time(const run_ctx *ctx)
-{
-    double t = ctx->checkpoint_interval > 0.0 ? (double)ctx->next_checkpoint * ctx->checkpoint_interval
-                                              : ctx->t_restart;
-    return t < ctx->t_end ? t : INFINITY;
-}
 
 /* An automatic restart point once the work since the last one reaches checkpoint_work: on a
  * fine grid of time just after everything settled so far, so that every island's last step
@@ -81,26 +46,6 @@ static void plan_restart(run_ctx *ctx)
     double grid = ctx->t_end * 0x1p-20;
     double t = (floor(ctx->t_settled / grid) + 1.0) * grid;
     ctx->t_restart = t > ctx->t_settled ? t : ctx->t_settled + grid;
-}
-
-double bk_run_stop_time(const run_ctx *ctx)
-{
-    double t_stop = fmin(bk_run_checkpoint_time(ctx), ctx->t_breakpoint);
-    return t_stop < ctx->t_end ? t_stop : ctx->t_end;
-}
-
-double bk_run_zero_after(run_ctx *ctx, gsl_function *f, double lo, double hi)
-{
-    if (gsl_root_fsolver_set(ctx->brent, f, lo, hi) != GSL_SUCCESS)
-        return hi;
-    for (int iter = 0; iter < 200; ++iter) {
-        if (gsl_root_fsolver_iterate(ctx->brent) != GSL_SUCCESS)
-            break;
-        double a = gsl_root_fsolver_x_lower(ctx->brent), b = gsl_root_fsolver_x_upper(ctx->brent);
-        if (gsl_root_test_interval(a, b, 0.0, 4.0 * DBL_EPSILON) == GSL_SUCCESS)
-            break;
-    }
-    return gsl_root_fsolver_x_upper(ctx->brent);
 }
 
 static double sample_time(const run_ctx *ctx, long k)
@@ -269,6 +214,7 @@ static void free_ctx(run_ctx *ctx)
 {
     bk_run_catalog_free(ctx);
     bk_run_islands_free(ctx);
+    bk_run_partition_free(ctx);
     bk_scene_free(&ctx->scene);
     free(ctx->spring_energy_ref);
     free(ctx->instant);
@@ -377,7 +323,8 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
     ctx.instant_count = calloc(n, sizeof *ctx.instant_count);
     int rc = BK_OK;
     if (!ctx.spring_energy_ref || !ctx.friction || !ctx.cof || !ctx.state_out ||
-        !ctx.last_transition || !ctx.instant_count || bk_run_islands_init(&ctx) != 0) {
+        !ctx.last_transition || !ctx.instant_count || bk_run_islands_init(&ctx) != 0 ||
+        bk_run_partition_init(&ctx) != 0) {
         rc = BK_FAIL(err, BK_ERR_NOMEM, "out of memory for %zu blocks", n);
         goto done;
     }
@@ -446,15 +393,4 @@ done:
     }
     free_ctx(&ctx);
     return rc;
-}
-
-const double *bk_run_probe_state(bk_block_probe *probe, double t)
-{
-    run_ctx *ctx = probe->ctx;
-    int rc = ctx->backend->interpolate(probe->isl->solver, t, probe->isl->y_probe, ctx->err);
-    if (rc != BK_OK) {
-        probe->status = rc;
-        return NULL;
-    }
-    return probe->isl->y_probe;
 }

@@ -1,6 +1,7 @@
 /* The event catalog during a run: the builder (bksim/catalog.h) fed with every transition as
- * it happens, completed events handed to the sink, the largest slip rate of each event, and
- * for laws without a stuck state the threshold crossings that stand in for transitions.
+ * it happens (run_transitions.c hands them on, with the threshold crossings that stand in for
+ * transitions of laws without a stuck state), completed events handed to the sink, and the
+ * largest slip rate of each event.
  *
  * The largest slip rate.  Between restarts a block's speed |v| is smooth, so its maxima are
  * at step ends or where d|v|/dt falls through zero inside a step.  Each step end is looked at
@@ -14,24 +15,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "output/layout.h"
-#include "run_impl.h"
+#include "layout.h"
+#include "run_ctx.h"
 
 static double applied_force(const void *user, size_t i)
 {
     const run_ctx *ctx = user;
     double driver_pos = bk_driver_position(&ctx->model->driver, ctx->t_catalog);
     return bk_scene_applied_force(&ctx->scene, i, driver_pos);
-}
-
-/* For the builder: stuck or slipping, and for a law without a stuck state below or above the
- * threshold. */
-static int8_t catalog_mode(const run_ctx *ctx, size_t i)
-{
-    const bk_scene *scene = &ctx->scene;
-    if (scene->can_stick[i])
-        return scene->mode[i];
-    return scene->above[i] ? (int8_t)BK_MODE_SLIP_POS : (int8_t)BK_MODE_STICK;
 }
 
 int bk_run_catalog_init(run_ctx *ctx, const bk_checkpoint *from)
@@ -132,30 +123,6 @@ int bk_run_catalog_transition(run_ctx *ctx, const bk_transition *transition)
         return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the event catalog at t = %.17g s",
                        transition->t);
     return done ? emit(ctx, &event) : BK_OK;
-}
-
-int bk_run_catalog_crossing(run_ctx *ctx, double t, size_t i)
-{
-    bk_scene *scene = &ctx->scene;
-    if (ctx->n_instant > 0 && t != ctx->t_instant) {
-        int rc = bk_run_flush_instant(ctx);
-        if (rc != BK_OK)
-            return rc;
-    }
-    double driver_pos = bk_driver_position(&ctx->model->driver, t);
-    int8_t from = catalog_mode(ctx, i);
-    scene->above[i] = (uint8_t)!scene->above[i];
-    ctx->steps_since_row = 0; /* progress, as a transition is, for the hang guard */
-    bk_transition crossing = {
-        .t = t,
-        .block = (int32_t)i,
-        .from = from,
-        .to = catalog_mode(ctx, i),
-        .x = scene->x[i],
-        .v = scene->v[i],
-        .force = bk_scene_applied_force(scene, i, driver_pos),
-    };
-    return bk_run_catalog_transition(ctx, &crossing);
 }
 
 int bk_run_catalog_finish(run_ctx *ctx, double t)

@@ -16,7 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "run_impl.h"
+#include "run_ctx.h"
 
 int bk_run_partition_init(run_ctx *ctx)
 {

@@ -5,7 +5,7 @@
  * rest, the first zero of the margin is bracketed and located by Brent. */
 #include <math.h>
 
-#include "run_impl.h"
+#include "run_ctx.h"
 
 /* Samples of a stateful block's threshold margin per doubling of the look-ahead. */
 #define AGING_SCAN_START (1.0 / 64.0)

@@ -1,5 +1,5 @@
-/* `bksim stats`: the report of src/output/h5_stats.c presented as text, one JSON object,
- * or TSV tables for gnuplot. */
+/* `bksim stats`: the report of src/stats_report.c presented as text, one JSON object, or
+ * TSV tables for gnuplot. */
 #include "bksim/stats.h"
 
 #include <errno.h>

@@ -13,7 +13,7 @@
 #include "exact_single.h"
 #include "linear_chain.h"
 #include "recorder.h"
-#include "solver/exact_impl.h"
+#include "solver/exact_backend.h"
 #include "scene_spec.h"
 
 #define PI 3.14159265358979323846

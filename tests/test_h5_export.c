@@ -14,7 +14,7 @@
 #include "bksim/bksim.h"
 #include "command.h"
 #include "h5_raw.h"
-#include "output/layout.h"
+#include "layout.h"
 #include "output_fixture.h"
 #include "output_files.h"
 

@@ -9,7 +9,7 @@
 #include <hdf5.h>
 
 #include "bksim/bksim.h"
-#include "output/layout.h"
+#include "layout.h"
 #include "h5_raw.h"
 #include "output_fixture.h"
 #include "output_files.h"

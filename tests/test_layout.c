@@ -1,4 +1,4 @@
-/* The output layout table (src/output/layout.c): the datasets, the [output] fields words,
+/* The output layout table (src/layout.c): the datasets, the [output] fields words,
  * the bytes per row and the dataset list, and that the config's max_bytes guard counts
  * exactly what the table describes. */
 #include "bk_test.h"
@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "bksim/bksim.h"
-#include "output/layout.h"
+#include "layout.h"
 
 static void test_table_well_formed(void **state)
 {

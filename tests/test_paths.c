@@ -1,4 +1,4 @@
-/* The file-system side of output files (src/output/paths.c): the .part naming every caller
+/* The file-system side of output files (src/paths.c): the .part naming every caller
  * shares, directories made on the way, and the durable rename with clear failures. */
 #include "bk_test.h"
 
@@ -8,7 +8,7 @@
 
 #include "bksim/bksim.h"
 #include "files.h"
-#include "output/paths.h"
+#include "paths.h"
 #include "output_fixture.h"
 
 static void test_part_names(void **state)

@@ -15,6 +15,7 @@
 #include "bksim/output.h"
 #include "bksim/param.h"
 #include "bksim/run.h"
+#include "bksim/sink.h"
 #include "bksim/solver.h"
 #include "bksim/stats.h"
 #include "bksim/status.h"

@@ -14,7 +14,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "bksim/run.h"
+#include "bksim/sink.h"
 
 typedef struct bk_event {
     double t_start, t_end;   /* s: first slip onset, last stick (t_end of the run if open) */

@@ -5,7 +5,7 @@
  * One field-descriptor table (bk_checkpoint_fields) drives allocation, the checksum and the
  * HDF5 slot writer and reader, as REBOUND's binary field table drives its save, load and
  * compare.  Adding a field means: the struct member, its row in the table (src/checkpoint.c),
- * and its capture and restore in the run loop (src/run.c) — nothing else. */
+ * and its capture and restore in the run loop (src/run_restart.c) — nothing else. */
 #ifndef BKSIM_CHECKPOINT_H
 #define BKSIM_CHECKPOINT_H
 
@@ -13,7 +13,7 @@
 #include <stdint.h>
 
 #include "bksim/catalog.h"
-#include "bksim/run.h"
+#include "bksim/sink.h"
 
 /* Arrays have n_blocks entries (state: n_state).  Keep every member 8 bytes wide (or an
  * array pointer): tests/test_checkpoint.c proves each byte of the struct is described by

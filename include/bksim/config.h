@@ -9,6 +9,7 @@
 #include <stdio.h>
 
 #include "bksim/model.h"
+#include "bksim/solver.h"
 #include "bksim/status.h"
 
 /* Output fields beyond /time and /driver, which are always written. */
@@ -22,23 +23,6 @@ enum {
     BK_FIELD_STATE = 1u << 6,    /* /friction_state, per law */
     BK_FIELD_ALL = (1u << 7) - 1
 };
-
-typedef struct bk_solver_options {
-    char method[32];        /* back-end name, e.g. "cvode_adams"; default "auto" */
-    char linear_solver[16]; /* "dense" | "band" | "auto" (implicit methods); default "auto" */
-    double rtol;            /* relative tolerance; default 1e-8 */
-    double atol_x;          /* m; NaN = auto (rtol * 1e-3 * slip length scale) */
-    double atol_v;          /* m/s; NaN = auto (rtol * 1e-3 * velocity scale) */
-    double max_step;        /* s; NaN = auto (1/8 of the fastest natural period) */
-    long max_steps;         /* solver steps allowed between two output rows; default 100000 */
-    int detect_velocity_extrema; /* locate slip-rate minima to catch hidden stops; default 1 */
-    long max_transitions_per_instant; /* per block, before a chattering error; default 100 */
-    double instant_window;  /* s: transitions closer than this count as one instant;
-                               NaN = auto (1e-6 of the fastest natural period) */
-    double min_step;        /* s: a step below this is an error; 0 = no limit (default) */
-    char arkode_table[48];  /* ARKODE Butcher table of arkode_erk / arkode_dirk; "default":
-                               the method's own (Zonneveld 5_3_4, SDIRK 5_3_4) */
-} bk_solver_options;
 
 /* The two full rows of a transition instant (before and after) cost 2 (17 + 33 N) bytes for
  * N blocks, against the 38 of the transition record: cheap on short chains, where figures

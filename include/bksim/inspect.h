@@ -1,5 +1,6 @@
 /* HDF5 output, the read side: the summary and integrity check behind `bksim info`, the text
- * export behind `bksim export`, and whole-dataset readers.  The file layout is described in
+ * export behind `bksim export`, whole-dataset readers, the catalog behind `bksim stats` and
+ * the sweep table behind `bksim summary`.  The file layout is described in
  * bksim/output.h (the write side). */
 #ifndef BKSIM_INSPECT_H
 #define BKSIM_INSPECT_H
@@ -7,7 +8,7 @@
 #include <stddef.h>
 #include <stdio.h>
 
-#include "bksim/run.h"
+#include "bksim/sink.h"
 #include "bksim/stats.h"
 #include "bksim/status.h"
 
@@ -58,6 +59,17 @@ int bk_h5_read_transitions(const char *path, bk_transition **rows, size_t *count
                            bk_error *err);
 /* Read /events (a catalog written by bksim: every bk_event field); *rows malloc'ed. */
 int bk_h5_read_events(const char *path, bk_event **rows, size_t *count, bk_error *err);
+
+/* An earthquake catalog's /events table (any HDF5 file: a 1-D compound dataset with at least
+ * t_start and magnitude; potency, n_blocks, complete and t_end read when present, in any
+ * numeric type) into *table (bk_event_table_free), with the root attribute t_reached of a
+ * bksim output (NaN without one).  Fails on a file that cannot be read, has no /events, or
+ * whose /events lacks t_start or magnitude; *table is then empty. */
+int bk_h5_read_event_table(const char *path, bk_event_table *table, bk_error *err);
+/* `bksim stats FILE`: bk_h5_read_event_table, then bk_stats_report_compute with the file's
+ * path as the source. */
+int bk_stats_report_read(const char *path, const bk_stats_options *opt, bk_stats_report **out,
+                         bk_error *err);
 
 /* `bksim summary DIR`: one row per finished run (complete *.h5) in dir, sorted by file name:
  * file, point (the sweep's grid point), one column per --set key any run used (named by the

@@ -26,7 +26,7 @@
 
 #include "bksim/checkpoint.h"
 #include "bksim/config.h"
-#include "bksim/run.h"
+#include "bksim/sink.h"
 #include "bksim/status.h"
 
 typedef struct bk_h5_writer bk_h5_writer;

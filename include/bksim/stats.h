@@ -1,8 +1,9 @@
 /* Earthquake-catalog statistics: the numbers behind `bksim stats FILE`.
  *
- * The estimators (src/stats.c) are pure numerics on plain arrays: no HDF5, no printing.
- * The report (src/output/h5_stats.c) reads a catalog's /events table from any HDF5 file and
- * prints or writes what the estimators give.
+ * Nothing here touches a file format.  The estimators (src/stats.c) are pure numerics on
+ * plain arrays; the report (src/stats_report.c) runs them on a catalog's columns in memory
+ * (bk_event_table) and is printed by src/stats_print.c.  Reading a catalog from an HDF5 file
+ * is the read side's (bksim/inspect.h: bk_h5_read_event_table, bk_stats_report_read).
  *
  * Magnitude bins.  Bins of width dm are centred on multiples of dm: a magnitude M belongs to
  * bin k = floor(M/dm + 0.5 + eps), eps = BK_MAG_BIN_EPS, whose centre is k dm.  The epsilon
@@ -195,6 +196,21 @@ void bk_stats_options_default(bk_stats_options *opt);
 /* BK_ERR_INVALID with a message naming the option and its allowed range. */
 int bk_stats_options_check(const bk_stats_options *opt, bk_error *err);
 
+/* An earthquake catalog's columns in memory, one entry per event: t_start and magnitude
+ * always, the others NULL where the catalog has no such field. */
+typedef struct bk_event_table {
+    size_t n;
+    double *t_start, *magnitude;  /* s, 1 */
+    double *t_end, *potency;      /* s, m */
+    int32_t *n_blocks;
+    int8_t *complete;             /* 0: still running at the end of the run */
+    double t_reached;             /* s: the simulated span of the run that wrote the catalog
+                                     (runs start at t = 0), NaN when that is not known */
+} bk_event_table;
+
+/* Free the columns and zero the table. */
+void bk_event_table_free(bk_event_table *table);
+
 /* Everything `bksim stats` reports about one catalog.  A statistic the catalog cannot
  * support (too few events above Mc, no potency field...) has have_* = 0 and the reason in
  * its *_note; the report as a whole fails only when the file is no catalog. */
@@ -244,11 +260,12 @@ typedef struct bk_stats_report {
     char ks_note[BK_ERROR_MESSAGE_LEN];
 } bk_stats_report;
 
-/* Read /events of the HDF5 file path (read-only) and compute everything; *out is
- * allocated (bk_stats_report_free).  Fails on a file that cannot be read, has no /events,
- * or whose /events lacks t_start or magnitude. */
-int bk_stats_report_read(const char *path, const bk_stats_options *opt, bk_stats_report **out,
-                         bk_error *err);
+/* Compute everything from a catalog's columns (opt NULL: the defaults); source names the
+ * catalog in the report and in messages.  *out is allocated (bk_stats_report_free).  Fails
+ * only on bad options or lack of memory: a statistic the catalog cannot support is noted in
+ * the report. */
+int bk_stats_report_compute(const bk_event_table *table, const char *source,
+                            const bk_stats_options *opt, bk_stats_report **out, bk_error *err);
 void bk_stats_report_free(bk_stats_report *report);
 /* The human-readable report; BK_ERR_IO when writing fails. */
 int bk_stats_report_text(const bk_stats_report *report, FILE *out, bk_error *err);

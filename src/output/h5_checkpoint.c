@@ -1,4 +1,5 @@
-/* Checkpoint slots in the output file, and the restart that continues from them.
+/* Checkpoint slots in the output file: written in turn, read back and verified (the restart
+ * that continues from them is h5_resume.c).
  *
  * The slot writer and reader loop over the checkpoint's field table (bksim/checkpoint.h):
  * arrays become datasets of the slot, scalars attributes, in the table's order. */
@@ -11,7 +12,7 @@
 
 #include "bksim/bksim.h"
 #include "output/h5_impl.h"
-#include "output/paths.h"
+#include "paths.h"
 
 /* A checkpoint has to survive a crash while the next one is written.  HDF5 writes raw data
  * when asked but keeps attributes in its metadata cache until a flush, so a checkpoint
@@ -145,20 +146,12 @@ static herr_t get_field(hid_t group, const bk_checkpoint_field *f, bk_checkpoint
     return rc;
 }
 
-/* Rows up to the checkpoint are flushed first, so the row counts it records are on disk. */
-int bk_h5_sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
+int bk_h5_write_checkpoint(hid_t file, const char *part, int slot, const bk_checkpoint *cp,
+                           const bk_checkpoint_record *rec, bk_error *err)
 {
-    bk_h5_writer *w = self;
-    if (w->failed)
-        return BK_FAIL(err, BK_ERR_HDF5, "%s: an earlier write failed; no checkpoint", w->part);
-    int rc = bk_h5_writer_flush(w, err);
-    if (rc != BK_OK)
-        return rc;
-    bk_checkpoint_record rec = {w->cp_sequence + 1, (long long)w->rows,
-                                (long long)w->trans.written, w->trans_last_t};
-    uint64_t checksum = bk_checkpoint_hash(cp, &rec);
+    uint64_t checksum = bk_checkpoint_hash(cp, rec);
     int created = 0, slot_created = 0;
-    hid_t top = open_or_create_group(w->file, "checkpoint", &created);
+    hid_t top = open_or_create_group(file, "checkpoint", &created);
     herr_t ok = top < 0 ? -1 : 0;
     if (ok >= 0 && created)
         ok = bk_h5_describe_fixed(top, "a, b: checkpoint slots",
@@ -166,7 +159,7 @@ int bk_h5_sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
                                   "slots written in turn, the newest that verifies (sequence, "
                                   "checksum) is used");
     hid_t group = ok < 0 ? H5I_INVALID_HID
-                         : open_or_create_group(top, SLOT_NAMES[w->cp_slot], &slot_created);
+                         : open_or_create_group(top, SLOT_NAMES[slot], &slot_created);
     if (group < 0)
         ok = -1;
     for (size_t k = 0; ok >= 0 && k < bk_checkpoint_n_fields; ++k)
@@ -180,13 +173,13 @@ int bk_h5_sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
     if (ok >= 0)
         ok = bk_h5_write_long_attr(group, "n_state", (long long)cp->n_state);
     if (ok >= 0)
-        ok = bk_h5_write_long_attr(group, "rows", rec.rows);
+        ok = bk_h5_write_long_attr(group, "rows", rec->rows);
     if (ok >= 0)
-        ok = bk_h5_write_long_attr(group, "transition_rows", rec.transition_rows);
+        ok = bk_h5_write_long_attr(group, "transition_rows", rec->transition_rows);
     if (ok >= 0)
-        ok = bk_h5_write_double_attr(group, "last_transition_t", rec.last_transition_t);
+        ok = bk_h5_write_double_attr(group, "last_transition_t", rec->last_transition_t);
     if (ok >= 0)
-        ok = bk_h5_write_long_attr(group, "sequence", rec.sequence);
+        ok = bk_h5_write_long_attr(group, "sequence", rec->sequence);
     if (ok >= 0)
         ok = bk_h5_write_stats(group, &cp->stats);
     if (ok >= 0)
@@ -197,12 +190,8 @@ int bk_h5_sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
                                   "transition_rows, last_transition_t, the arrays, the scalars and "
                                   "stats");
     CLOSE_IDS(ok, group, top);
-    if (ok < 0 || H5Fflush(w->file, H5F_SCOPE_LOCAL) < 0) {
-        w->failed = 1;
-        return H5_FAIL(err, "%s: cannot write /checkpoint/%s", w->part, SLOT_NAMES[w->cp_slot]);
-    }
-    w->cp_sequence = rec.sequence;
-    w->cp_slot ^= 1;
+    if (ok < 0 || H5Fflush(file, H5F_SCOPE_LOCAL) < 0)
+        return H5_FAIL(err, "%s: cannot write /checkpoint/%s", part, SLOT_NAMES[slot]);
     return BK_OK;
 }
 
@@ -235,7 +224,7 @@ static herr_t read_stats(hid_t group, bk_run_stats *stats)
 }
 
 /* A dataset transfer that skips Fletcher32 checks; H5P_DEFAULT-like otherwise. */
-static hid_t unchecked_xfer(void)
+hid_t bk_h5_unchecked_xfer(void)
 {
     hid_t dxpl = H5Pcreate(H5P_DATASET_XFER);
     if (dxpl >= 0 && H5Pset_edc_check(dxpl, H5Z_DISABLE_EDC) < 0) {
@@ -250,8 +239,8 @@ static hid_t unchecked_xfer(void)
  * checkpoint's last row: a run killed while appending to that chunk may have left it half
  * rewritten, and both versions hold the same bytes in the rows up to the checkpoint, so those
  * rows are intact even though the chunk's checksum is not. */
-static herr_t read_rows_lenient(hid_t dset, int rank, hsize_t start, hsize_t count, hsize_t cols,
-                                hid_t mem_type, void *buf, int *unchecked)
+herr_t bk_h5_read_rows_lenient(hid_t dset, int rank, hsize_t start, hsize_t count, hsize_t cols,
+                               hid_t mem_type, void *buf, int *unchecked)
 {
     if (unchecked)
         *unchecked = 0;
@@ -259,7 +248,7 @@ static herr_t read_rows_lenient(hid_t dset, int rank, hsize_t start, hsize_t cou
         return 0;
     if (unchecked)
         *unchecked = 1;
-    hid_t dxpl = unchecked_xfer();
+    hid_t dxpl = bk_h5_unchecked_xfer();
     herr_t rc = dxpl < 0 ? -1 : bk_h5_read_block_xfer(dset, rank, start, count, 0, cols, mem_type, buf, dxpl);
     CLOSE_IDS(rc, dxpl);
     return rc;
@@ -292,7 +281,7 @@ static int slot_matches_data(hid_t file, const bk_checkpoint *cp, const bk_check
         snprintf(why, why_len, "records %lld rows, /time has %lld", rec->rows, rows);
         rc = -1;
     } else if (rec->rows > 0 &&
-               (read_rows_lenient(time, 1, (hsize_t)(rec->rows - 1), 1, 1, H5T_NATIVE_DOUBLE, &t, NULL) < 0 ||
+               (bk_h5_read_rows_lenient(time, 1, (hsize_t)(rec->rows - 1), 1, 1, H5T_NATIVE_DOUBLE, &t, NULL) < 0 ||
                 t != cp->t_last_row)) {
         snprintf(why, why_len, "its last row is at t = %.17g s, /time[%lld] = %.17g s",
                  cp->t_last_row, rec->rows - 1, t);
@@ -323,7 +312,7 @@ static int slot_matches_data(hid_t file, const bk_checkpoint *cp, const bk_check
         snprintf(why, why_len, "records %lld transitions, /transitions has %lld",
                  rec->transition_rows, count < 0 ? 0 : count);
         rc = -1;
-    } else if (read_rows_lenient(table, 1, (hsize_t)(rec->transition_rows - 1), 1, 1, mem, &last, NULL) < 0 ||
+    } else if (bk_h5_read_rows_lenient(table, 1, (hsize_t)(rec->transition_rows - 1), 1, 1, mem, &last, NULL) < 0 ||
                last.t != rec->last_transition_t) {
         snprintf(why, why_len, "its last transition is at t = %.17g s, /transitions[%lld] at %.17g s",
                  rec->last_transition_t, rec->transition_rows - 1, last.t);
@@ -471,211 +460,4 @@ int bk_h5_find_checkpoint(hid_t file, const char *path, size_t n_blocks, bk_h5_s
     slot->record = recs[best];
     slot->index = best;
     return BK_OK;
-}
-
-/* Truncate dset to rows, dropping what was written after the checkpoint.  When the chunk
- * holding the last of those rows fails its checksum (see read_rows_lenient), its rows up to
- * the checkpoint are first written back over it, checks off for the read that write makes,
- * so that it is whole again.  The chunk is rewritten in place, never dropped and written
- * anew: a kill between dropping it and flushing its replacement could lose it from the
- * chunk index, and its rows would read back as zeros. */
-static herr_t truncate_rows(hid_t dset, hsize_t rows, hid_t mem_type, size_t row_bytes)
-{
-    hid_t space = H5Dget_space(dset);
-    hsize_t dims[2] = {0, 0};
-    int rank = space < 0 ? -1 : H5Sget_simple_extent_dims(space, dims, NULL);
-    CLOSE_IDS(rank, space);
-    if (rank < 1 || rank > 2 || dims[0] < rows)
-        return -1;
-    hsize_t chunk = bk_h5_chunk_rows(dset);
-    hsize_t start = chunk > 0 ? rows / chunk * chunk : rows;
-    herr_t rc = 0;
-    if (start < rows) {
-        hsize_t count = rows - start;
-        void *buf = malloc((size_t)count * row_bytes);
-        int unchecked = 0;
-        rc = buf ? read_rows_lenient(dset, rank, start, count, dims[1], mem_type, buf, &unchecked) : -1;
-        if (rc >= 0 && unchecked) {
-            hsize_t offset[2] = {start, 0}, counts[2] = {count, dims[1]};
-            hid_t file_space = H5Dget_space(dset);
-            hid_t mem_space = H5Screate_simple(rank, counts, NULL);
-            hid_t dxpl = unchecked_xfer();
-            rc = file_space < 0 || mem_space < 0 || dxpl < 0 ||
-                         H5Sselect_hyperslab(file_space, H5S_SELECT_SET, offset, NULL, counts, NULL) < 0
-                     ? -1
-                     : H5Dwrite(dset, mem_type, mem_space, file_space, dxpl, buf);
-            CLOSE_IDS(rc, dxpl, mem_space, file_space);
-        }
-        free(buf);
-    }
-    dims[0] = rows;
-    return rc < 0 ? rc : H5Dset_extent(dset, dims);
-}
-
-int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config_out,
-                        bk_checkpoint *checkpoint, bk_error *err)
-{
-    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-    if (!out || !path || !config_out || !checkpoint)
-        return BK_FAIL(err, BK_ERR_INVALID,
-                       "bk_h5_writer_resume: needs writer, path, config and checkpoint pointers");
-    *out = NULL;
-    *config_out = NULL;
-    memset(checkpoint, 0, sizeof *checkpoint);
-    char *final_path = bk_output_final_path(path);
-    if (!final_path)
-        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
-    bk_h5_writer *w;
-    int rc = bk_h5_writer_new(&w, final_path, err);
-    free(final_path);
-    if (rc != BK_OK)
-        return rc;
-    struct stat st;
-    if (stat(w->part, &st) != 0) {
-        int complete = 0;
-        hid_t done = stat(w->path, &st) == 0 ? H5Fopen(w->path, H5F_ACC_RDONLY, H5P_DEFAULT) : H5I_INVALID_HID;
-        if (done >= 0)
-            bk_h5_read_numeric_attr(done, "complete", H5T_NATIVE_INT, &complete);
-        CLOSE_IDS(0, done);
-        rc = BK_FAIL(err, BK_ERR_INVALID, "%s: %s", w->part,
-                         complete ? "no such file; the run is complete, nothing to restart"
-                                  : "no such file to restart from");
-        bk_h5_writer_free(w);
-        return rc;
-    }
-    bk_config *config = NULL;
-    bk_h5_slot slot;
-    memset(&slot, 0, sizeof slot);
-    const bk_checkpoint *cp = &slot.checkpoint;
-    const bk_checkpoint_record *rec = &slot.record;
-    if (bk_output_write_locked(w->part))
-        rc = BK_FAIL(err, BK_ERR_IO, BK_OUTPUT_OWNED_MESSAGE, w->part);
-    else
-        w->file = H5Fopen(w->part, H5F_ACC_RDWR, H5P_DEFAULT);
-    if (rc == BK_OK)
-        rc = w->file < 0 ? H5_FAIL(err, "%s: cannot open for the restart", w->part) : BK_OK;
-    /* HDF5 writes the superblock, which holds the end of allocated space (EOA), last in a
-     * flush; a kill inside a flush can leave blocks written past the EOA it records.  Space
-     * freed there (a chunk dropped by the truncation below) would then be handed out again
-     * and every write to it fail ("addr overflow").  Nothing on disk lies past the end of the
-     * file, so moving the EOA there is safe. */
-    haddr_t eoa = 0;
-    if (rc == BK_OK && H5Fget_eoa(w->file, &eoa) >= 0 && (haddr_t)st.st_size > eoa &&
-        H5Fincrement_filesize(w->file, 0) < 0)
-        rc = H5_FAIL(err, "%s: cannot extend the allocated space to the end of the file", w->part);
-    /* The checkpoint before the config: it needs no variable-length string (see
-     * bk_h5_write_fixed_string_attr), so a file without one is refused without reading any. */
-    long long n_blocks = 0;
-    if (rc == BK_OK && (bk_h5_read_numeric_attr(w->file, "n_blocks", H5T_NATIVE_LLONG, &n_blocks) < 0 ||
-                        n_blocks < 1))
-        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: no valid root attribute n_blocks", w->part);
-    if (rc == BK_OK)
-        rc = bk_h5_find_checkpoint(w->file, w->part, (size_t)n_blocks, &slot, err);
-    if (rc == BK_OK)
-        rc = bk_h5_load_stored_config(w->file, w->part, &config, err);
-    if (rc == BK_OK && (config->model->n_blocks != cp->n_blocks ||
-                        config->model->n_friction_state != cp->n_state))
-        rc = BK_FAIL(err, BK_ERR_DAMAGED,
-                     "%s: damaged: the checkpoint holds %zu blocks and %zu friction states, the "
-                     "stored config makes %zu and %zu", w->part, cp->n_blocks, cp->n_state,
-                     config->model->n_blocks, config->model->n_friction_state);
-    if (rc == BK_OK) {
-        char *names = bk_h5_recorded_datasets(w->file);
-        rc = bk_h5_require_datasets(w->file, w->part, names, err);
-        free(names);
-    }
-    if (rc == BK_OK) {
-        const bk_model *model = config->model;
-        bk_h5_writer_size(w, model);
-        hsize_t rows = (hsize_t)rec->rows;
-        for (int i = 0; rc == BK_OK && i < BK_N_SERIES; ++i) {
-            bk_h5_series *ser = &w->s[i];
-            if (H5Lexists(w->file, bk_series[i].name, H5P_DEFAULT) <= 0)
-                continue;
-            ser->dset = H5Dopen2(w->file, bk_series[i].name, H5P_DEFAULT);
-            if (ser->dset < 0 || bk_h5_writer_series(w, i, model) < 0 ||
-                truncate_rows(ser->dset, rows, bk_h5_kind_mem_type(bk_series[i].kind), ser->cols * ser->elem) < 0)
-                rc = H5_FAIL(err, "%s: cannot reopen /%s at the checkpoint's %llu rows", w->part,
-                             bk_series[i].name, (unsigned long long)rows);
-        }
-        if (rc == BK_OK && H5Lexists(w->file, "transitions", H5P_DEFAULT) > 0) {
-            int buffered = bk_h5_writer_table(&w->trans, 0);
-            w->trans.dset = H5Dopen2(w->file, "transitions", H5P_DEFAULT);
-            if (buffered < 0 || w->trans.dset < 0 ||
-                truncate_rows(w->trans.dset, (hsize_t)rec->transition_rows, w->trans.mem,
-                              sizeof(bk_transition)) < 0)
-                rc = H5_FAIL(err, "%s: cannot reopen /transitions at the checkpoint", w->part);
-        }
-        /* /events goes with a checkpoint that carries the catalog: both, or neither. */
-        int has_events = rc == BK_OK ? H5Lexists(w->file, "events", H5P_DEFAULT) > 0 : 0;
-        if (rc == BK_OK && has_events != (cp->catalog != NULL))
-            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: %s", w->part,
-                         has_events ? "/events exists but the checkpoint holds no catalog"
-                                    : "the checkpoint holds a catalog but there is no /events");
-        if (rc == BK_OK && has_events) {
-            int buffered = bk_h5_writer_table(&w->events, 1);
-            w->events.dset = H5Dopen2(w->file, "events", H5P_DEFAULT);
-            if (buffered < 0 || w->events.dset < 0 ||
-                truncate_rows(w->events.dset, (hsize_t)cp->catalog->events, w->events.mem, sizeof(bk_event)) < 0)
-                rc = H5_FAIL(err, "%s: cannot reopen /events at the checkpoint", w->part);
-            w->events.written = (hsize_t)cp->catalog->events;
-        }
-        w->rows = rows;
-        w->trans.written = (hsize_t)rec->transition_rows;
-        w->trans_last_t = rec->last_transition_t;
-        w->t_written = w->t_buffered = cp->t_last_row;
-        /* The next checkpoint goes into the other slot: this one stays the fallback. */
-        w->cp_sequence = rec->sequence;
-        w->cp_slot = slot.index ^ 1;
-        if (rc == BK_OK && (bk_h5_write_int_attr(w->file, "complete", 0) < 0 ||
-                            bk_h5_write_double_attr(w->file, "t_reached", w->t_written) < 0 ||
-                            (H5Aexists(w->file, "error") > 0 && H5Adelete(w->file, "error") < 0)))
-            rc = H5_FAIL(err, "%s: cannot reset the root attributes for the restart", w->part);
-    }
-    if (rc != BK_OK) {
-        bk_h5_writer_close(w);
-        bk_h5_writer_free(w);
-        bk_checkpoint_free(&slot.checkpoint);
-        bk_config_free(config);
-        return rc;
-    }
-    *out = w;
-    *config_out = config;
-    *checkpoint = slot.checkpoint;
-    return BK_OK;
-}
-
-int bk_h5_restartable(const char *path, double *t_checkpoint, bk_error *err)
-{
-    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-    if (!path || !*path)
-        return BK_FAIL(err, BK_ERR_INVALID, "bk_h5_restartable: no output path given");
-    char *final_path = bk_output_final_path(path);
-    char *part = final_path ? bk_output_part_path(final_path) : NULL;
-    free(final_path);
-    if (!part)
-        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
-    struct stat st;
-    hid_t file = H5I_INVALID_HID;
-    int result = 0;
-    if (stat(part, &st) == 0 && S_ISREG(st.st_mode) && bk_h5_has_signature(part) > 0)
-        file = H5Fopen(part, H5F_ACC_RDONLY, H5P_DEFAULT);
-    long long n_blocks = 0;
-    if (file >= 0 && bk_h5_read_numeric_attr(file, "n_blocks", H5T_NATIVE_LLONG, &n_blocks) >= 0 &&
-        n_blocks > 0 && H5Lexists(file, "checkpoint", H5P_DEFAULT) > 0) {
-        bk_h5_slot slot;
-        bk_error ignored;
-        int found = bk_h5_find_checkpoint(file, part, (size_t)n_blocks, &slot, &ignored);
-        if (found == BK_OK) {
-            if (t_checkpoint)
-                *t_checkpoint = slot.checkpoint.t;
-            bk_checkpoint_free(&slot.checkpoint);
-            result = 1;
-        } else if (found == BK_ERR_NOMEM) {
-            result = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory reading /checkpoint", part);
-        }
-    }
-    bk_h5_close_id(file);
-    free(part);
-    return result;
 }

@@ -18,7 +18,7 @@
 #include "bksim/checkpoint.h"
 #include "bksim/config.h"
 #include "bksim/output.h"
-#include "output/layout.h"
+#include "layout.h"
 
 /* Rows of a 2-D chunk, and of the buffer that fills one.  A chunk of a T x N dataset is
  * capped at CHUNK_BYTES so wide chains keep chunks (and the buffers, one chunk per
@@ -100,10 +100,6 @@ void bk_h5_writer_free(bk_h5_writer *w);
 /* Commit: append everything buffered, record t_reached and flush HDF5's metadata, so that
  * the file on disk is readable and consistent up to here (see h5_writer.c). */
 int bk_h5_writer_flush(bk_h5_writer *w, bk_error *err);
-/* The solver statistics as attributes of group "stats" in obj. */
-herr_t bk_h5_write_stats(hid_t obj, const bk_run_stats *stats);
-/* The sink's checkpoint callback (h5_checkpoint.c). */
-int bk_h5_sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err);
 
 /* ------------------------------------------------------------ error plumbing --- */
 
@@ -144,6 +140,8 @@ herr_t bk_h5_describe(hid_t obj, const char *units, const char *description);
 herr_t bk_h5_describe_fixed(hid_t obj, const char *units, const char *description);
 char *bk_h5_read_string_attr(hid_t obj, const char *name);
 herr_t bk_h5_read_numeric_attr(hid_t obj, const char *name, hid_t mem_type, void *value);
+/* The solver statistics as attributes of group "stats" in obj. */
+herr_t bk_h5_write_stats(hid_t obj, const bk_run_stats *stats);
 
 /* --------------------------------------------------------------------- types --- */
 
@@ -217,6 +215,19 @@ int bk_h5_require_datasets(hid_t file, const char *path, const char *names, bk_e
 int bk_h5_load_stored_config(hid_t file, const char *path, bk_config **config, bk_error *err);
 
 /* --------------------------------------------------------------- checkpoints --- */
+
+/* Write cp into slot 0 (/checkpoint/a) or 1 (/checkpoint/b) of file (named part in a
+ * message) with its consistency record and checksum, and flush: the rows it counts must be
+ * on disk already. */
+int bk_h5_write_checkpoint(hid_t file, const char *part, int slot, const bk_checkpoint *cp,
+                           const bk_checkpoint_record *rec, bk_error *err);
+/* A dataset transfer that skips Fletcher32 checks; H5P_DEFAULT-like otherwise. */
+hid_t bk_h5_unchecked_xfer(void);
+/* Rows [start, start + count) of a dataset, reading a chunk whose checksum fails as it is;
+ * *unchecked (may be NULL) tells whether that was needed (h5_checkpoint.c says when that is
+ * safe). */
+herr_t bk_h5_read_rows_lenient(hid_t dset, int rank, hsize_t start, hsize_t count, hsize_t cols,
+                               hid_t mem_type, void *buf, int *unchecked);
 
 /* A checkpoint read back from a slot of /checkpoint. */
 typedef struct bk_h5_slot {

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "output/h5_impl.h"
-#include "output/paths.h"
+#include "paths.h"
 
 /* Unit of key in a "key: unit, key: unit" list; "" when not listed. */
 static void unit_of(const char *units, const char *key, char *buf, size_t len)

@@ -10,7 +10,7 @@
 
 #include "capacity.h"
 #include "output/h5_impl.h"
-#include "output/paths.h"
+#include "paths.h"
 
 int bk_h5_open_input(const char *path, hid_t *file, bk_error *err)
 {

@@ -396,3 +396,56 @@ void bk_h5_pack_event(const bk_event *event, unsigned char *row)
 {
     pack(event_fields, N_FIELDS(event_fields), event, row);
 }
+
+herr_t bk_h5_write_stats(hid_t file, const bk_run_stats *stats)
+{
+    hid_t gcpl = H5I_INVALID_HID, group = H5I_INVALID_HID;
+    herr_t rc = -1;
+    htri_t exists = H5Lexists(file, "stats", H5P_DEFAULT);
+    if (exists < 0)
+        goto done;
+    if (exists) {
+        group = H5Gopen2(file, "stats", H5P_DEFAULT);
+    } else {
+        /* Creation order lets `bksim info` list the statistics in this table's order. */
+        gcpl = H5Pcreate(H5P_GROUP_CREATE);
+        if (gcpl < 0 ||
+            H5Pset_attr_creation_order(gcpl, H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED) < 0)
+            goto done;
+        group = H5Gcreate2(file, "stats", H5P_DEFAULT, gcpl, H5P_DEFAULT);
+    }
+    if (group < 0)
+        goto done;
+    char method[sizeof stats->method + 1];
+    memcpy(method, stats->method, sizeof stats->method);
+    method[sizeof stats->method] = '\0';
+    if (bk_h5_write_fixed_string_attr(group, "method", method) < 0)
+        goto done;
+    char units[1024] = "";
+    size_t used = 0;
+    for (size_t i = 0; i < bk_run_stats_n_fields; ++i) {
+        const char *field = (const char *)stats + bk_run_stats_fields[i].offset;
+        herr_t ok;
+        if (bk_run_stats_fields[i].if_nonzero && bk_stat_is_zero(stats, &bk_run_stats_fields[i]))
+            continue;
+        if (bk_run_stats_fields[i].is_long) {
+            long value;
+            memcpy(&value, field, sizeof value);
+            ok = bk_h5_write_long_attr(group, bk_run_stats_fields[i].name, value);
+        } else {
+            double value;
+            memcpy(&value, field, sizeof value);
+            ok = bk_h5_write_double_attr(group, bk_run_stats_fields[i].name, value);
+        }
+        if (ok < 0)
+            goto done;
+        int n = snprintf(units + used, sizeof units - used, "%s%s: %s", i ? ", " : "",
+                         bk_run_stats_fields[i].name, bk_run_stats_fields[i].units);
+        if (n > 0 && (size_t)n < sizeof units - used)
+            used += (size_t)n;
+    }
+    rc = bk_h5_describe_fixed(group, units, "solver statistics of the run");
+done:
+    CLOSE_IDS(rc, group, gcpl);
+    return rc;
+}

@@ -13,7 +13,7 @@
 
 #include "bksim/bksim.h"
 #include "output/h5_impl.h"
-#include "output/paths.h"
+#include "paths.h"
 
 /* Shuffle + deflate at this level; 0 writes unfiltered chunks.  Off because it costs more
  * than it saves when output is dense: on stick-slip-like data level 1 shrank files to
@@ -590,63 +590,31 @@ static int sink_event(void *self, const bk_event *event, bk_error *err)
     return buffer_record(w, &w->events, "events", event, 1, err);
 }
 
-bk_sink bk_h5_writer_sink(bk_h5_writer *writer)
+/* Rows up to the checkpoint are flushed first, so the row counts it records are on disk. */
+static int sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
 {
-    bk_sink sink = {writer, sink_sample, sink_transition, bk_h5_sink_checkpoint, sink_event};
-    return sink;
+    bk_h5_writer *w = self;
+    if (w->failed)
+        return BK_FAIL(err, BK_ERR_HDF5, "%s: an earlier write failed; no checkpoint", w->part);
+    int rc = bk_h5_writer_flush(w, err);
+    if (rc != BK_OK)
+        return rc;
+    bk_checkpoint_record rec = {w->cp_sequence + 1, (long long)w->rows,
+                                (long long)w->trans.written, w->trans_last_t};
+    rc = bk_h5_write_checkpoint(w->file, w->part, w->cp_slot, cp, &rec, err);
+    if (rc != BK_OK) {
+        w->failed = 1;
+        return rc;
+    }
+    w->cp_sequence = rec.sequence;
+    w->cp_slot ^= 1;
+    return BK_OK;
 }
 
-herr_t bk_h5_write_stats(hid_t file, const bk_run_stats *stats)
+bk_sink bk_h5_writer_sink(bk_h5_writer *writer)
 {
-    hid_t gcpl = H5I_INVALID_HID, group = H5I_INVALID_HID;
-    herr_t rc = -1;
-    htri_t exists = H5Lexists(file, "stats", H5P_DEFAULT);
-    if (exists < 0)
-        goto done;
-    if (exists) {
-        group = H5Gopen2(file, "stats", H5P_DEFAULT);
-    } else {
-        /* Creation order lets `bksim info` list the statistics in this table's order. */
-        gcpl = H5Pcreate(H5P_GROUP_CREATE);
-        if (gcpl < 0 ||
-            H5Pset_attr_creation_order(gcpl, H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED) < 0)
-            goto done;
-        group = H5Gcreate2(file, "stats", H5P_DEFAULT, gcpl, H5P_DEFAULT);
-    }
-    if (group < 0)
-        goto done;
-    char method[sizeof stats->method + 1];
-    memcpy(method, stats->method, sizeof stats->method);
-    method[sizeof stats->method] = '\0';
-    if (bk_h5_write_fixed_string_attr(group, "method", method) < 0)
-        goto done;
-    char units[1024] = "";
-    size_t used = 0;
-    for (size_t i = 0; i < bk_run_stats_n_fields; ++i) {
-        const char *field = (const char *)stats + bk_run_stats_fields[i].offset;
-        herr_t ok;
-        if (bk_run_stats_fields[i].if_nonzero && bk_stat_is_zero(stats, &bk_run_stats_fields[i]))
-            continue;
-        if (bk_run_stats_fields[i].is_long) {
-            long value;
-            memcpy(&value, field, sizeof value);
-            ok = bk_h5_write_long_attr(group, bk_run_stats_fields[i].name, value);
-        } else {
-            double value;
-            memcpy(&value, field, sizeof value);
-            ok = bk_h5_write_double_attr(group, bk_run_stats_fields[i].name, value);
-        }
-        if (ok < 0)
-            goto done;
-        int n = snprintf(units + used, sizeof units - used, "%s%s: %s", i ? ", " : "",
-                         bk_run_stats_fields[i].name, bk_run_stats_fields[i].units);
-        if (n > 0 && (size_t)n < sizeof units - used)
-            used += (size_t)n;
-    }
-    rc = bk_h5_describe_fixed(group, units, "solver statistics of the run");
-done:
-    CLOSE_IDS(rc, group, gcpl);
-    return rc;
+    bk_sink sink = {writer, sink_sample, sink_transition, sink_checkpoint, sink_event};
+    return sink;
 }
 
 /* After a failure that followed complete = 1: take the mark back, so a .part never claims

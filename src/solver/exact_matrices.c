@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "exact_impl.h"
+#include "exact_backend.h"
 
 static int add_coupling(exact_backend *eb, size_t row, size_t col, double value)
 {

@@ -10,7 +10,7 @@
 #include <gsl/gsl_vector.h>
 #include <lapacke.h>
 
-#include "exact_impl.h"
+#include "exact_backend.h"
 
 /* --- the modal basis functions ---------------------------------------------------------- */
 

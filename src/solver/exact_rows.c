@@ -17,7 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "exact_impl.h"
+#include "exact_backend.h"
 
 /* Below this many pairs a cluster's modal sum (2 size^2 products) is cheaper than the series
  * (about 14 sparse products of 3 entries per pair plus its sums): bench/exact_rows.c

@@ -1,4 +1,4 @@
-/* Maps [solver] method names to back-end tables; what every back-end shares (counters). */
+/* Maps [solver] method names to back-end tables. */
 #include <string.h>
 
 #include "bksim/solver.h"
@@ -27,13 +27,4 @@ const bk_solver_backend *bk_solver_backend_find(const char *name)
         if (strcmp((*b)->name, name) == 0)
             return *b;
     return NULL;
-}
-
-void bk_solver_counters_add(bk_solver_counters *sum, const bk_solver_counters *more)
-{
-    sum->steps += more->steps;
-    sum->rhs_evals += more->rhs_evals;
-    sum->root_evals += more->root_evals;
-    sum->err_test_fails += more->err_test_fails;
-    sum->nonlin_iters += more->nonlin_iters;
 }

@@ -6,7 +6,7 @@
 
 #include "bk_test.h"
 #include "bksim/bksim.h"
-#include "output/layout.h"
+#include "layout.h"
 
 void assert_same_output(const char *a, const char *b)
 {

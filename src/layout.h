@@ -3,8 +3,8 @@
  * bytes a row takes on disk (what the [output] max_bytes guard estimates).  The writer, the
  * verifier, the exporter and the config loader all read this table, so a dataset added here
  * is created, checked and counted in the size guard at once. */
-#ifndef BKSIM_OUTPUT_LAYOUT_H
-#define BKSIM_OUTPUT_LAYOUT_H
+#ifndef BKSIM_LAYOUT_H
+#define BKSIM_LAYOUT_H
 
 #include <stddef.h>
 

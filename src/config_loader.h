@@ -1,9 +1,11 @@
-/* Private to the config loader, shared by its four files: config_keys.c (the key table and
- * the reference), config_parse.c (text to checked entries), config_build.c (entries to a
- * bk_config, with the cross-key checks) and config.c (the public entry points).  Not
- * installed: the public API is include/bksim/config.h. */
-#ifndef BKSIM_CONFIG_IMPL_H
-#define BKSIM_CONFIG_IMPL_H
+/* Private to the config loader, shared by its files: config_keys.c (the key table and the
+ * reference), config_report.c (failures with their location), config_parse.c (text to
+ * checked entries), config_random.c (values drawn per block), config_build.c (entries to a
+ * bk_config, with the cross-key checks), config_warnings.c (plausibility warnings) and
+ * config.c (the public entry points).  Not installed: the public API is
+ * include/bksim/config.h. */
+#ifndef BKSIM_CONFIG_LOADER_H
+#define BKSIM_CONFIG_LOADER_H
 
 #include <limits.h>
 #include <stddef.h>
@@ -83,11 +85,19 @@ typedef struct loader {
  * then the --set overrides (INT_MAX + k), then keys that are missing altogether. */
 #define RANK_MISSING (LONG_MAX - 1)
 
+/* --- reporting failures (config_report.c) ---------------------------------------------- */
+
+/* Record a failure at `rank` unless an earlier one is already recorded. */
 void bk_config_report(loader *ld, long rank, int status, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
+/* The same for entry e: "file:line: [section] key: " and the message, at the entry's rank. */
 void bk_config_report_entry(loader *ld, const entry *e, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+/* "file:12" or "--set block.mass=0". */
 void bk_config_location(const loader *ld, const entry *e, char *buf, size_t len);
+
+/* --- text to checked entries (config_parse.c) ------------------------------------------- */
+
 int bk_config_add_entry(loader *ld, const char *section, const char *key, const char *value, int line,
                         const char *override, long rank);
 /* inih's reader and handler (ini_parse_stream(bk_config_read_line, ld, bk_config_on_pair, ld)). */

@@ -1,8 +1,7 @@
-/* Internal: the run loop's state, shared by run.c (set-up and the scheduler), run_islands.c
- * (the partition into islands and quiet blocks, island steps and events), run_quiet.c (when a
- * quiet block breaks away) and run_output.c (rows, transitions, energies, checkpoints). */
-#ifndef BKSIM_RUN_IMPL_H
-#define BKSIM_RUN_IMPL_H
+/* Internal: the run loop's state, shared by run.c (set-up and the scheduler) and the files
+ * it calls down into, one job each (listed at the end of this header with what they export). */
+#ifndef BKSIM_RUN_CTX_H
+#define BKSIM_RUN_CTX_H
 
 #include <stddef.h>
 #include <stdint.h>
@@ -151,14 +150,116 @@ static inline int bk_compare_blocks(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* ---- run.c ---- */
-double bk_run_wall_seconds(void);
-/* The wall-clock limit and a stop request, checked at every step and row. */
-int bk_run_report_progress(run_ctx *ctx, double t);
-/* Next checkpoint time (+inf without checkpoints); always < t_end or +inf. */
-double bk_run_checkpoint_time(const run_ctx *ctx);
-/* Where every island's integrator stops: the next checkpoint or t_end. */
-double bk_run_stop_time(const run_ctx *ctx);
+/* The run loop's files call one another downward only, in the order they are listed below:
+ * run.c (set-up and the scheduler) on top, then restarts, island events, the partition, the
+ * islands, quiet blocks, rows, transitions, the catalog, the energy books, probes and the
+ * clock.  A file calls only files listed after it, never one before: no circle of calls
+ * (make lint checks it on the objects, scripts/lint_calls.sh). */
+
+/* ---- run_restart.c ---- */
+/* Every island restarted at t (islands stopped there), as a resumed run starts.  At a restart
+ * point (restart_point) the state is first recorded as a checkpoint when the wall-clock
+ * interval has passed; otherwise (a driver breakpoint) only the restart. */
+int bk_run_restart_all(run_ctx *ctx, double t, int restart_point);
+/* The state of a checkpoint, back into the chain. */
+int bk_run_resume(run_ctx *ctx, const bk_checkpoint *cp);
+/* Statistics so far, the resumed run's included. */
+void bk_run_collect_stats(const run_ctx *ctx, bk_run_stats *stats, double cpu0);
+
+/* ---- run_events.c ---- */
+/* One step of island id; records the event it finds (pending). */
+int bk_run_island_step(run_ctx *ctx, size_t id);
+/* Apply the machine to block i at t (the chain's arrays unpacked there): the transition and
+ * the energy books.  Returns 1 when its mode changed, 0 when not, < 0 on failure. */
+int bk_run_apply_event(run_ctx *ctx, double t, size_t i, bk_mode_event event);
+/* Handle the pending event of island id at its t_event. */
+int bk_run_island_event(run_ctx *ctx, size_t id);
+/* Every quiet block failing at t (to rounding) breaks away. */
+int bk_run_quiet_failures(run_ctx *ctx, double t);
+
+/* ---- run_partition.c ---- */
+int bk_run_partition_init(run_ctx *ctx);
+void bk_run_partition_free(run_ctx *ctx);
+/* Dissolve every island and rebuild the whole partition at t (the chain's arrays hold the
+ * state there): at the start, at checkpoints and on resuming. */
+int bk_run_partition_all(run_ctx *ctx, double t);
+/* Rebuild the partition at t around the seed blocks, whose modes changed: they, their
+ * partners and every island those touch (dissolved at t; `taken`: the one whose increments
+ * were already taken, or BK_NO_ISLAND). */
+int bk_run_repartition(run_ctx *ctx, const size_t *seeds, size_t n_seeds, double t, size_t taken);
+
+/* ---- run_islands.c ---- */
+int bk_run_islands_init(run_ctx *ctx);
+void bk_run_islands_free(run_ctx *ctx);
+/* Dissolve island id at t: its state into the chain (unless `taken`: already there) and its
+ * energy increments into the closed totals. */
+int bk_run_dissolve(run_ctx *ctx, size_t id, double t, int taken);
+/* A new island over these blocks (in the island's order), started at t. */
+int bk_run_found_island(run_ctx *ctx, const size_t *blocks, size_t len, double t);
+/* (Re)start island id at t on its blocks' current state. */
+int bk_run_start_island(run_ctx *ctx, size_t id, double t);
+/* The island's state at t into the chain's arrays: its own vector where it stands at t,
+ * else dense output (t lies in its last step: see the scheduler in run.c); for an output
+ * row (for_row), the back-end's output-row interpolant where it has one.  Its energy
+ * increments since its start go to *increments. */
+int bk_run_unpack_island(run_ctx *ctx, run_island *isl, double t, int for_row, bk_energy *increments);
+/* Fill the chain's arrays with every island's state at t (interpolated, or the island's
+ * own vector where it stands at t), and ctx->total with the totals. */
+int bk_run_unpack_all(run_ctx *ctx, double t);
+/* Counters of every back-end instance so far. */
+void bk_run_solver_counters(const run_ctx *ctx, bk_solver_counters *total);
+
+/* ---- run_quiet.c ---- */
+/* Block i (stuck, next to no slipping block) leaves the integrators at t; its breakaway
+ * time goes into the quiet queue. */
+void bk_run_make_quiet(run_ctx *ctx, size_t i, double t);
+
+/* ---- run_rows.c ---- */
+/* A regular sample row from the chain's arrays at t (bk_run_unpack_all first). */
+int bk_run_emit_sample(run_ctx *ctx, double t);
+/* The two rows of a transition instant at t (unpacked there): the state just before its
+ * transitions, then just after. */
+int bk_run_emit_event_rows(run_ctx *ctx, double t);
+
+/* ---- run_transitions.c ---- */
+/* A mode change of block i at t with the applied force then: chattering guard, statistics,
+ * and the transition, buffered until its instant ends. */
+int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_mode to,
+                             double applied_force);
+/* Block i (a law without a stuck state, unpacked at t) crosses the slip-rate threshold: a
+ * transition for the catalog only. */
+int bk_run_record_crossing(run_ctx *ctx, double t, size_t i);
+/* Send the buffered transitions of the instant, in block order. */
+int bk_run_flush_instant(run_ctx *ctx);
+
+/* ---- run_catalog.c ---- */
+/* The builder, begun at t = 0 from the chain's arrays or restored from a checkpoint (none
+ * when [output] events is off, or the checkpoint predates catalogs). */
+int bk_run_catalog_init(run_ctx *ctx, const bk_checkpoint *from);
+void bk_run_catalog_free(run_ctx *ctx);
+/* A transition, as it happens; a completed event goes to the sink. */
+int bk_run_catalog_transition(run_ctx *ctx, const bk_transition *transition);
+/* The end of the run at t (the chain's arrays unpacked there): the last event. */
+int bk_run_catalog_finish(run_ctx *ctx, double t);
+/* The builder's state for a checkpoint; NULL without a catalog. */
+bk_catalog_state *bk_run_catalog_save(run_ctx *ctx);
+/* Slip rates of an island just (re)started, and of its last step (maxima inside it too). */
+void bk_run_catalog_island_start(run_ctx *ctx, const run_island *isl);
+int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl);
+
+/* ---- run_books.c ---- */
+/* Block i changes between stuck and slipping at t (the chain's arrays unpacked): the
+ * driver's work on it while it was stuck is closed, or its stuck interval opens. */
+void bk_run_leave_stuck(run_ctx *ctx, size_t i, double t);
+void bk_run_enter_stuck(run_ctx *ctx, size_t i, double t);
+/* Driver work and dissipation at t from the closed totals, the islands' increments and the
+ * stuck blocks' springs (J); the islands' increments are given. */
+void bk_run_energy_totals(run_ctx *ctx, double t, const bk_energy *islands);
+/* Close every stuck interval's books at t: the closed totals take everything so far and the
+ * stuck blocks' references restart at t (a checkpoint, or a resumed run's start). */
+void bk_run_rebase_energy(run_ctx *ctx, double t);
+
+/* ---- run_probe.c ---- */
 /* The zero of f in [lo, hi] (opposite signs at the ends) located by Brent to rounding: the
  * upper end of the final bracket, past the zero as at a root an integrator reports; hi when
  * GSL refuses the bracket. */
@@ -173,91 +274,16 @@ typedef struct bk_block_probe {
 /* The island's vector at t (in isl->y_probe); NULL, with status set, when the back-end fails. */
 const double *bk_run_probe_state(bk_block_probe *probe, double t);
 
-/* ---- run_islands.c ---- */
-int bk_run_islands_init(run_ctx *ctx);
-void bk_run_islands_free(run_ctx *ctx);
-/* Dissolve island id at t: its state into the chain (unless `taken`: already there) and its
- * energy increments into the closed totals. */
-int bk_run_dissolve(run_ctx *ctx, size_t id, double t, int taken);
-/* A new island over these blocks (in the island's order), started at t. */
-int bk_run_found_island(run_ctx *ctx, const size_t *blocks, size_t len, double t);
-/* One step of island id; records the event it finds (pending). */
-int bk_run_island_step(run_ctx *ctx, size_t id);
-/* Apply the machine to block i at t (the chain's arrays unpacked there): the transition and
- * the energy books.  Returns 1 when its mode changed, 0 when not, < 0 on failure. */
-int bk_run_apply_event(run_ctx *ctx, double t, size_t i, bk_mode_event event);
-/* Handle the pending event of island id at its t_event. */
-int bk_run_island_event(run_ctx *ctx, size_t id);
-/* Every quiet block failing at t (to rounding) breaks away. */
-int bk_run_quiet_failures(run_ctx *ctx, double t);
-/* run_quiet.c: block i (stuck, next to no slipping block) leaves the integrators at t; its
- * breakaway time goes into the quiet queue. */
-void bk_run_make_quiet(run_ctx *ctx, size_t i, double t);
-/* Fill the chain's arrays with every island's state at t (interpolated, or the island's
- * own vector where it stands at t), and ctx->total with the totals. */
-int bk_run_unpack_all(run_ctx *ctx, double t);
-/* Counters of every back-end instance so far. */
-void bk_run_solver_counters(const run_ctx *ctx, bk_solver_counters *total);
-
-/* ---- run_partition.c ---- */
-int bk_run_partition_init(run_ctx *ctx);
-void bk_run_partition_free(run_ctx *ctx);
-/* Dissolve every island and rebuild the whole partition at t (the chain's arrays hold the
- * state there): at the start, at checkpoints and on resuming. */
-int bk_run_partition_all(run_ctx *ctx, double t);
-/* Rebuild the partition at t around the seed blocks, whose modes changed: they, their
- * partners and every island those touch (dissolved at t; `taken`: the one whose increments
- * were already taken, or BK_NO_ISLAND). */
-int bk_run_repartition(run_ctx *ctx, const size_t *seeds, size_t n_seeds, double t, size_t taken);
-
-/* ---- run_catalog.c ---- */
-/* The builder, begun at t = 0 from the chain's arrays or restored from a checkpoint (none
- * when [output] events is off, or the checkpoint predates catalogs). */
-int bk_run_catalog_init(run_ctx *ctx, const bk_checkpoint *from);
-void bk_run_catalog_free(run_ctx *ctx);
-/* A transition, as it happens; a completed event goes to the sink. */
-int bk_run_catalog_transition(run_ctx *ctx, const bk_transition *transition);
-/* Block i (a law without a stuck state, unpacked at t) crosses the slip-rate threshold. */
-int bk_run_catalog_crossing(run_ctx *ctx, double t, size_t i);
-/* The end of the run at t (the chain's arrays unpacked there): the last event. */
-int bk_run_catalog_finish(run_ctx *ctx, double t);
-/* The builder's state for a checkpoint; NULL without a catalog. */
-bk_catalog_state *bk_run_catalog_save(run_ctx *ctx);
-/* Slip rates of an island just (re)started, and of its last step (maxima inside it too). */
-void bk_run_catalog_island_start(run_ctx *ctx, const run_island *isl);
-int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl);
-
-/* ---- run_output.c ---- */
+/* ---- run_clock.c ---- */
+double bk_run_wall_seconds(void);
+/* The progress callback (which may stop the run) and the wall-clock limit, checked at every
+ * step and row. */
+int bk_run_report_progress(run_ctx *ctx, double t);
+/* Next checkpoint time (+inf without checkpoints); always < t_end or +inf. */
+double bk_run_checkpoint_time(const run_ctx *ctx);
+/* Where every island's integrator stops: the next checkpoint, a driver breakpoint or t_end. */
+double bk_run_stop_time(const run_ctx *ctx);
 /* Count bytes written (rows, transitions, events) against [output] max_bytes at t. */
 int bk_run_count_bytes(run_ctx *ctx, double bytes, double t);
-/* A regular sample row from the chain's arrays at t (bk_run_unpack_all first). */
-int bk_run_emit_sample(run_ctx *ctx, double t);
-/* The two rows of a transition instant at t (unpacked there): the state just before its
- * transitions, then just after. */
-int bk_run_emit_event_rows(run_ctx *ctx, double t);
-/* A mode change of block i at t with the applied force then: chattering guard, statistics,
- * and the transition, buffered until its instant ends. */
-int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_mode to,
-                             double applied_force);
-/* Send the buffered transitions of the instant, in block order. */
-int bk_run_flush_instant(run_ctx *ctx);
-/* Block i changes between stuck and slipping at t (the chain's arrays unpacked): the
- * driver's work on it while it was stuck is closed, or its stuck interval opens. */
-void bk_run_leave_stuck(run_ctx *ctx, size_t i, double t);
-void bk_run_enter_stuck(run_ctx *ctx, size_t i, double t);
-/* Driver work and dissipation at t from the closed totals, the islands' increments and the
- * stuck blocks' springs (J); the islands' increments are given. */
-void bk_run_energy_totals(run_ctx *ctx, double t, const bk_energy *islands);
-/* Statistics so far, the resumed run's included. */
-void bk_run_collect_stats(const run_ctx *ctx, bk_run_stats *stats, double cpu0);
-/* Every island restarted at t (islands stopped there), as a resumed run starts.  At a restart
- * point (restart_point) the state is first recorded as a checkpoint when the wall-clock
- * interval has passed; otherwise (a driver breakpoint) only the restart. */
-int bk_run_restart_all(run_ctx *ctx, double t, int restart_point);
-/* The state of a checkpoint, back into the chain. */
-int bk_run_resume(run_ctx *ctx, const bk_checkpoint *cp);
-/* Close every stuck interval's books at t: the closed totals take everything so far and the
- * stuck blocks' references restart at t (a checkpoint, or a resumed run's start). */
-void bk_run_rebase_energy(run_ctx *ctx, double t);
 
 #endif

@@ -1,6 +1,6 @@
 /* File-system helpers of the writer (paths.c); the .part naming is public (output.h). */
-#ifndef BKSIM_OUTPUT_PATHS_H
-#define BKSIM_OUTPUT_PATHS_H
+#ifndef BKSIM_PATHS_H
+#define BKSIM_PATHS_H
 
 #include "bksim/status.h"
 

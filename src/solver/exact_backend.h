@@ -1,8 +1,9 @@
-/* Internal to the exact stepper (exact.c: memory, start, stepping and events;
- * exact_matrices.c: reading K, P, Q and the forcing from the problem; exact_modes.c: the
- * clusters, their modes and the closed-form state).  exact.c's header says what it computes. */
-#ifndef BKSIM_EXACT_IMPL_H
-#define BKSIM_EXACT_IMPL_H
+/* Internal to the exact stepper (exact.c: start, stepping and events; exact_work.c: its
+ * memory; exact_matrices.c: reading K, P, Q and the forcing from the problem; exact_modes.c:
+ * the clusters, their modes and the closed-form state; exact_rows.c: output rows of long
+ * clusters).  exact.c's header says what it computes. */
+#ifndef BKSIM_EXACT_BACKEND_H
+#define BKSIM_EXACT_BACKEND_H
 
 #include <float.h>
 #include <stddef.h>
@@ -119,9 +120,16 @@ typedef struct exact_backend {
 /* exact_matrices.c: the affine forcing at t0 and K, P, Q (from the Jacobian when the problem
  * has one, else one probe per column); the right-hand side checked for finite values. */
 int bk_exact_read_problem(exact_backend *eb, bk_error *err);
-/* exact.c: room for n_couplings + 1 couplings in shared->couplings; -1: out of memory. */
+/* exact_work.c: the thread's shared work space, taken by every instance (NULL: out of
+ * memory) and given back when it is destroyed. */
+exact_shared *bk_exact_shared_acquire(void);
+void bk_exact_shared_release(exact_shared *s);
+/* exact_work.c: room for a start of n components (p pairs, m quadratures, n_roots root
+ * functions): the shared work space and the instance's own arena, pointers set into both. */
+int bk_exact_reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_roots, bk_error *err);
+/* exact_work.c: room for n_couplings + 1 couplings in shared->couplings; -1: out of memory. */
 int bk_exact_reserve_coupling(exact_backend *eb);
-/* exact.c: the shared work copy for a cluster of `largest` pairs into eb->work. */
+/* exact_work.c: the shared work copy for a cluster of `largest` pairs into eb->work. */
 int bk_exact_reserve_work(exact_backend *eb, size_t largest, bk_error *err);
 /* exact_modes.c: clusters and their modes (after bk_exact_read_problem); the exact state at t. */
 int bk_exact_modes(exact_backend *eb, bk_error *err);

@@ -1,20 +1,14 @@
-/* `bksim stats`: read an earthquake catalog (/events of any HDF5 file), run the estimators
- * of stats.c on it (src/stats_print.c presents the result).
+/* `bksim stats`: everything the report says about one catalog, from its columns in memory
+ * (bk_event_table; src/output/h5_event_table.c reads them from an HDF5 file) through the
+ * estimators of stats.c.  No HDF5 and no printing here (stats_print.c presents the report).
  *
  * A catalog needs only t_start and magnitude; the other fields of bksim's own catalogs
- * (potency, n_blocks, complete, t_end) add statistics when present.  Each field is read on
- * its own through a one-member compound memory type, so HDF5 converts whatever numeric
- * type the file holds and the order and the other members of the table do not matter. */
+ * (potency, n_blocks, complete, t_end) add statistics when present. */
 #include "bksim/stats.h"
 
-#include <errno.h>
-#include <stddef.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-
-#include "output/h5_impl.h"
 
 #define TWO_THIRDS (2.0 / 3.0)
 /* Magnitudes and potencies obey m = (2/3) log10 P + offset to this (in magnitude units) in
@@ -61,17 +55,7 @@ static int in_window(const bk_stats_options *opt, double t)
     return !(t < opt->t_from) && !(t >= opt->t_to);
 }
 
-/* ------------------------------------------------------------ reading --- */
-
-/* The columns of /events as read, one entry per row. */
-typedef struct events_table {
-    size_t n;
-    double *t_start, *magnitude, *t_end, *potency;
-    int32_t *n_blocks;
-    int8_t *complete;
-} events_table;
-
-static void events_table_free(events_table *t)
+void bk_event_table_free(bk_event_table *t)
 {
     free(t->t_start);
     free(t->magnitude);
@@ -81,131 +65,6 @@ static void events_table_free(events_table *t)
     free(t->complete);
     memset(t, 0, sizeof *t);
 }
-
-/* The member names of the compound file type, comma-separated, for a message. */
-static void member_names(hid_t type, char *buf, size_t len)
-{
-    buf[0] = '\0';
-    int members = H5Tget_nmembers(type);
-    size_t used = 0;
-    for (int i = 0; i < members && used + 1 < len; ++i) {
-        char *name = H5Tget_member_name(type, (unsigned)i);
-        if (!name)
-            continue;
-        int w = snprintf(buf + used, len - used, "%s%s", i ? ", " : "", name);
-        H5free_memory(name);
-        if (w < 0)
-            break;
-        used += (size_t)w;
-    }
-    if (used >= len && len > 4)
-        strcpy(buf + len - 4, "...");
-}
-
-/* Field name of the table as mem_type values into a new array *out (NULL and BK_OK when
- * the table has no such field; an error when it is there but not numeric). */
-static int read_field(hid_t dset, hid_t file_type, const char *path, size_t n, const char *name,
-                      hid_t mem_type, void **out, bk_error *err)
-{
-    *out = NULL;
-    int index = H5Tget_member_index(file_type, name);
-    if (index < 0) {
-        H5Eclear2(H5E_DEFAULT);
-        return BK_OK;
-    }
-    H5T_class_t cls = H5Tget_member_class(file_type, (unsigned)index);
-    if (cls != H5T_INTEGER && cls != H5T_FLOAT)
-        return BK_FAIL(err, BK_ERR_INVALID, "%s: /events field '%s' is not numeric", path, name);
-    size_t elem = H5Tget_size(mem_type);
-    void *buf = malloc(n ? n * elem : 1);
-    if (!buf)
-        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for %zu /events rows", path, n);
-    if (n > 0) {
-        hid_t mem = H5Tcreate(H5T_COMPOUND, elem);
-        herr_t rc = mem < 0 ? -1 : H5Tinsert(mem, name, 0, mem_type);
-        if (rc >= 0)
-            rc = H5Dread(dset, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
-        if (rc < 0) {
-            int status = H5_DAMAGED(err, "%s: cannot read field '%s' of /events", path, name);
-            CLOSE_IDS(-1, mem);
-            free(buf);
-            return status;
-        }
-        CLOSE_IDS(0, mem);
-    }
-    *out = buf;
-    return BK_OK;
-}
-
-static int read_events(hid_t file, const char *path, events_table *t, bk_error *err)
-{
-    memset(t, 0, sizeof *t);
-    htri_t exists = H5Lexists(file, "events", H5P_DEFAULT);
-    if (exists <= 0)
-        return BK_FAIL(err, BK_ERR_INVALID,
-                       "%s: no /events table (an earthquake catalog: a 1-D compound dataset "
-                       "with at least the fields t_start and magnitude)",
-                       path);
-    hid_t dset = H5Dopen2(file, "events", H5P_DEFAULT);
-    if (dset < 0)
-        return H5_FAIL(err, "%s: /events is not a readable dataset", path);
-    hid_t type = H5Dget_type(dset);
-    hid_t space = H5Dget_space(dset);
-    int rc = BK_OK;
-    if (type < 0 || space < 0) {
-        rc = H5_DAMAGED(err, "%s: cannot read the type and shape of /events", path);
-        goto done;
-    }
-    if (H5Tget_class(type) != H5T_COMPOUND || H5Sget_simple_extent_ndims(space) != 1) {
-        rc = BK_FAIL(err, BK_ERR_INVALID,
-                     "%s: /events must be a 1-D compound dataset (a table with fields t_start, "
-                     "magnitude, ...)",
-                     path);
-        goto done;
-    }
-    hsize_t rows = 0;
-    H5Sget_simple_extent_dims(space, &rows, NULL);
-    t->n = (size_t)rows;
-    const char *required[] = {"t_start", "magnitude"};
-    for (size_t k = 0; k < 2; ++k)
-        if (H5Tget_member_index(type, required[k]) < 0) {
-            H5Eclear2(H5E_DEFAULT);
-            char names[512];
-            member_names(type, names, sizeof names);
-            rc = BK_FAIL(err, BK_ERR_INVALID,
-                         "%s: /events has no field '%s' (a catalog needs t_start and magnitude; "
-                         "fields present: %s)",
-                         path, required[k], names[0] ? names : "none");
-            goto done;
-        }
-    /* Each column through its own one-member memory type (absent optional ones stay NULL). */
-    const struct {
-        const char *name;
-        hid_t memory_type;
-        size_t offset; /* of the column's pointer in events_table */
-    } columns[] = {
-        {"t_start", H5T_NATIVE_DOUBLE, offsetof(events_table, t_start)},
-        {"magnitude", H5T_NATIVE_DOUBLE, offsetof(events_table, magnitude)},
-        {"t_end", H5T_NATIVE_DOUBLE, offsetof(events_table, t_end)},
-        {"potency", H5T_NATIVE_DOUBLE, offsetof(events_table, potency)},
-        {"n_blocks", H5T_NATIVE_INT32, offsetof(events_table, n_blocks)},
-        {"complete", H5T_NATIVE_INT8, offsetof(events_table, complete)},
-    };
-    for (size_t k = 0; k < sizeof columns / sizeof *columns; ++k) {
-        void *column = NULL;
-        rc = read_field(dset, type, path, t->n, columns[k].name, columns[k].memory_type, &column, err);
-        if (rc != BK_OK)
-            goto done;
-        memcpy((char *)t + columns[k].offset, &column, sizeof column);
-    }
-done:
-    CLOSE_IDS(rc, space, type, dset);
-    if (rc != BK_OK)
-        events_table_free(t);
-    return rc;
-}
-
-/* ------------------------------------------------------------ computing --- */
 
 /* A statistic the catalog cannot support is noted, not fatal; anything else (memory) is. */
 static int note_or_fail(int rc, const bk_error *inner, char *note, size_t len, bk_error *err)
@@ -219,19 +78,16 @@ static int note_or_fail(int rc, const bk_error *inner, char *note, size_t len, b
     return rc;
 }
 
-/* Duration and rates: the run's simulated span when the file is a bksim output (runs start
+/* Duration and rates: the run's simulated span when the catalog is a bksim output (runs start
  * at t = 0), else the span of the catalog itself; either clipped to the time window. */
-static void set_duration(bk_stats_report *r, hid_t file, const events_table *t)
+static void set_duration(bk_stats_report *r, const bk_event_table *t)
 {
-    double t_reached = 0.0, start, end;
-    if (H5Aexists(file, "t_reached") > 0 &&
-        bk_h5_read_numeric_attr(file, "t_reached", H5T_NATIVE_DOUBLE, &t_reached) >= 0 &&
-        isfinite(t_reached) && t_reached > 0.0 && t_reached >= r->t_last) {
+    double start, end;
+    if (isfinite(t->t_reached) && t->t_reached > 0.0 && t->t_reached >= r->t_last) {
         start = 0.0;
-        end = t_reached;
+        end = t->t_reached;
         r->duration_from_run = 1;
     } else {
-        H5Eclear2(H5E_DEFAULT);
         start = r->t_first;
         end = r->t_last;
         if (t->t_end)
@@ -380,7 +236,7 @@ static int above_mc(bk_stats_report *r, bk_error *err)
     return rc;
 }
 
-static int compute_sizes(bk_stats_report *r, const events_table *t, bk_error *err)
+static int compute_sizes(bk_stats_report *r, const bk_event_table *t, bk_error *err)
 {
     if (!t->n_blocks) {
         snprintf(r->sizes_note, sizeof r->sizes_note, "the catalog has no n_blocks field");
@@ -404,7 +260,7 @@ static int compute_sizes(bk_stats_report *r, const events_table *t, bk_error *er
 }
 
 /* Keep the complete rows with a finite start and magnitude inside the time window. */
-static int select_events(bk_stats_report *r, const events_table *t, bk_error *err)
+static int select_events(bk_stats_report *r, const bk_event_table *t, bk_error *err)
 {
     size_t n = t->n ? t->n : 1;
     r->t_start = malloc(n * sizeof *r->t_start);
@@ -442,7 +298,7 @@ static int select_events(bk_stats_report *r, const events_table *t, bk_error *er
     return BK_OK;
 }
 
-static int compute(bk_stats_report *r, hid_t file, const events_table *t, bk_error *err)
+static int compute(bk_stats_report *r, const bk_event_table *t, bk_error *err)
 {
     r->n_rows = t->n;
     r->has_t_end = t->t_end != NULL;
@@ -452,7 +308,7 @@ static int compute(bk_stats_report *r, hid_t file, const events_table *t, bk_err
     int rc = select_events(r, t, err);
     if (rc != BK_OK)
         return rc;
-    set_duration(r, file, t);
+    set_duration(r, t);
     if ((rc = compute_sizes(r, t, err)) != BK_OK)
         return rc;
     if (!r->has_potency)
@@ -481,8 +337,8 @@ static int compute(bk_stats_report *r, hid_t file, const events_table *t, bk_err
     return above_mc(r, err);
 }
 
-int bk_stats_report_read(const char *path, const bk_stats_options *opt, bk_stats_report **out,
-                         bk_error *err)
+int bk_stats_report_compute(const bk_event_table *table, const char *source,
+                            const bk_stats_options *opt, bk_stats_report **out, bk_error *err)
 {
     *out = NULL;
     bk_stats_options defaults;
@@ -492,25 +348,15 @@ int bk_stats_report_read(const char *path, const bk_stats_options *opt, bk_stats
     int rc = bk_stats_options_check(opt, err);
     if (rc != BK_OK)
         return rc;
-    hid_t file;
-    if ((rc = bk_h5_open_input(path, &file, err)) != BK_OK)
-        return rc;
-    events_table table;
-    rc = read_events(file, path, &table, err);
-    bk_stats_report *r = NULL;
-    if (rc == BK_OK) {
-        r = calloc(1, sizeof *r);
-        if (r)
-            r->path = strdup(path);
-        if (!r || !r->path)
-            rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
+    bk_stats_report *r = calloc(1, sizeof *r);
+    if (r)
+        r->path = strdup(source);
+    if (!r || !r->path) {
+        bk_stats_report_free(r);
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", source);
     }
-    if (rc == BK_OK) {
-        r->options = *opt;
-        rc = compute(r, file, &table, err);
-    }
-    events_table_free(&table);
-    CLOSE_IDS(rc, file);
+    r->options = *opt;
+    rc = compute(r, table, err);
     if (rc != BK_OK) {
         bk_stats_report_free(r);
         return rc;

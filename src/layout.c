@@ -1,6 +1,6 @@
 /* The output layout table (see layout.h).  Units and descriptions are written verbatim as
  * the datasets' "units" and "description" attributes. */
-#include "output/layout.h"
+#include "layout.h"
 
 #include <stdio.h>
 

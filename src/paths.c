@@ -1,7 +1,7 @@
 /* The file-system side of an output file: its ".part" name while a run writes it, the
  * directories it goes in, and the durable rename that publishes it.  Free of HDF5. */
 #define _GNU_SOURCE /* sync_file_range */
-#include "output/paths.h"
+#include "paths.h"
 
 #include <errno.h>
 #include <fcntl.h>
