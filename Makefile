@@ -1,5 +1,7 @@
-# bksim: `make` builds libbksim.a and ./bksim; `make test` runs the cmocka suite twice,
-# plain and under AddressSanitizer + UndefinedBehaviorSanitizer.
+# bksim: `make` builds libbksim.a and ./bksim; `make test` runs every cmocka program once on
+# the plain build.  CI (.ci/run) adds the AddressSanitizer + UndefinedBehaviorSanitizer build
+# (make test-asan), valgrind (make test-valgrind), make lint, make fuzz-replay and
+# make test-slurm.
 
 CC       ?= gcc
 PKGS     := hdf5-serial gsl inih lapacke
@@ -60,10 +62,11 @@ build-asan/tests/test_%: build-asan/tests/test_%.o $(call objs,build-asan,$(TEST
 	$(CC) $(CFLAGS) $(SAN) -o $@ $^ $(TEST_LIBS) $(LDLIBS)
 
 # Tests run from the repository root (they read configs/ and need ./bksim for CLI tests).
-test: test-plain test-asan
+test: test-plain
 test-plain: bksim build/bench/bksim_bench build/bench/h5_plain build/bench/exact_rows $(TESTS)
 	@scripts/run_tests.sh build/tests $(TESTS)
-# The CLI tests run the sanitizer build of bksim too (BKSIM, relative to the repository root).
+# Every program again under the sanitizers (CI runs it); the CLI tests run the sanitizer
+# build of bksim too (BKSIM, relative to the repository root).
 test-asan: build-asan/bksim build/bench/bksim_bench build/bench/h5_plain build/bench/exact_rows $(TESTS_ASAN)
 	@BKSIM=build-asan/bksim BK_TEST_TIME_SCALE=10 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
 	 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \

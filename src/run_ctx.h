@@ -10,7 +10,8 @@
 
 #include "bksim/catalog.h"
 #include "bksim/checkpoint.h"
-#include "bksim/run.h"
+#include "bksim/config.h"
+#include "bksim/sink.h"
 #include "bksim/solver.h"
 #include "heap.h"
 #include "scene.h"

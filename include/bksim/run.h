@@ -8,18 +8,6 @@
 #include "bksim/sink.h"
 #include "bksim/status.h"
 
-/* What a progress callback is told: how far the run is, and what it has produced. */
-typedef struct bk_progress {
-    double t, t_end;     /* s; t is the furthest any part of the chain has got (parts run apart) */
-    double t_resumed;    /* s: where this call began (0, or the checkpoint it resumed) */
-    long transitions;    /* so far, a resumed run's earlier ones included */
-    long events;         /* completed events so far; -1 when the run keeps no catalog */
-    long events_resumed; /* events completed before t_resumed */
-} bk_progress;
-
-/* Called now and then; return non-zero to stop the run. */
-typedef int (*bk_progress_fn)(void *user, const bk_progress *progress);
-
 /* Run the configured scene from t = 0 to config->t_end, sending rows and transitions to
  * sink.  stats may be NULL.  Returns BK_OK, or a negative code with err filled (the sink
  * has then received a prefix of the run). */

@@ -1,5 +1,6 @@
 /* What a run hands on, and to what: the records (a time-series row, a transition, the run's
- * statistics) and the sink that takes them, with a checkpoint and the catalog's events.
+ * statistics) and the sink that takes them, with a checkpoint and the catalog's events; and
+ * its progress, to a callback that may stop it.
  * Everything that writes, reads or keeps a run's records includes this header rather than
  * the run loop's, which it need not see. */
 #ifndef BKSIM_SINK_H
@@ -88,5 +89,17 @@ typedef struct bk_run_stats {
     double kinetic_change;    /* J */
     double energy_residual;   /* (W - dE_el - dE_kin - D - D_damping) / the largest term, dimensionless */
 } bk_run_stats;
+
+/* What a progress callback is told: how far the run is, and what it has produced. */
+typedef struct bk_progress {
+    double t, t_end;     /* s; t is the furthest any part of the chain has got (parts run apart) */
+    double t_resumed;    /* s: where this call began (0, or the checkpoint it resumed) */
+    long transitions;    /* so far, a resumed run's earlier ones included */
+    long events;         /* completed events so far; -1 when the run keeps no catalog */
+    long events_resumed; /* events completed before t_resumed */
+} bk_progress;
+
+/* Called now and then; return non-zero to stop the run. */
+typedef int (*bk_progress_fn)(void *user, const bk_progress *progress);
 
 #endif
