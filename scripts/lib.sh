@@ -6,14 +6,15 @@
 #   BK_SCRIPTS, BK_REPO  this directory and the repository above it, absolute
 #   BK_SCRIPT            the running script, absolute (its help is read from it)
 #   BK_PROG              the name before every message (the script's; a script may set another)
-# Helpers of one topic source this and live beside it: plot_lib.sh (the paper figures' start)
-# and sweep_lib.sh (a sweep's plan and report).
+# Helpers of one topic live beside it and source it themselves (a script that needs them
+# sources only the topic's file): plot_lib.sh (what the plot scripts share beyond this) and
+# sweep_lib.sh (a sweep's plan and report).
 
 [ -z "${BK_LIB_LOADED:-}" ] || return 0
 BK_LIB_LOADED=1
 BK_SCRIPTS=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 BK_REPO=$(dirname "$BK_SCRIPTS")
-BK_SCRIPT=$(cd "$(dirname "$0")" 2> /dev/null && pwd)/$(basename "$0") || BK_SCRIPT=$0
+if BK_SCRIPT=$(cd "$(dirname "$0")" 2> /dev/null && pwd); then BK_SCRIPT+=/$(basename "$0"); else BK_SCRIPT=$0; fi
 BK_PROG=$(basename "$0")
 # Where the script was started: a relative $BKSIM names a file from there, even after a cd.
 BK_START_DIR=$PWD
