@@ -9,8 +9,10 @@
 # Takes about 30 minutes (the scaling part alone 19) on the machine in bench/machine.txt;
 # `scripts/bench.sh --quick` is a smoke run into a temporary directory, `--plot-only`
 # redraws the PNGs and tables from the TSVs in bench/.
+# usage: scripts/bench.sh [--quick | --plot-only]
 set -euo pipefail
-cd "$(dirname "$0")/.."
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+cd "$BK_REPO"
 bench=build/bench/bksim_bench
 out=bench
 quick=()
@@ -18,12 +20,15 @@ plot_only=0
 case "${1:-}" in
     --quick) quick=(--quick --repeats 1); out=$(mktemp -d) ;;
     --plot-only) plot_only=1 ;;
+    -h|--help) bk_help ;;
     "") ;;
-    *) echo "usage: $0 [--quick | --plot-only]" >&2; exit 2 ;;
+    *) bk_usage "unknown option '$1'" ;;
 esac
 mkdir -p "$out"
 
 if [ $plot_only = 0 ]; then
+    bk_find_bksim bksim
+    export BKSIM=$bksim # what every part below runs
     scripts/machine_info.sh > "$out/machine.txt"
 
     "$bench" "${quick[@]}" --out "$out/results.tsv"

@@ -12,22 +12,26 @@
 #      rtol 1e-8) with rows every 1e-3, 1e-4, 1e-5 s against transitions only, per back-end.
 #   3. The exact stepper's cost per row on one slipping non-uniform cluster of p blocks:
 #      the rows' path (bench/exact_rows.c) against the modal sum, p = 16 .. 2048.
-# Usage: scripts/bench_output.sh [--quick] OUT_DIR
+# usage: scripts/bench_output.sh [--quick] OUT_DIR
 # Writes OUT_DIR/output_writer.tsv, OUT_DIR/output_rhs.tsv, OUT_DIR/output_exact_rows.tsv
 # and OUT_DIR/output.md.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+cd "$BK_REPO"
 quick=0
-if [ "${1:-}" = --quick ]; then quick=1; shift; fi
-out=${1:?usage: $0 [--quick] OUT_DIR}
-bksim=./bksim
+case ${1:-} in
+    --quick) quick=1; shift ;;
+    -h|--help) bk_help ;;
+esac
+[ $# -ge 1 ] || bk_usage "missing OUT_DIR"
+out=$1
+bk_find_bksim bksim 2
 plain=build/bench/h5_plain
 exact_rows=build/bench/exact_rows
-for tool in "$bksim" "$plain" "$exact_rows"; do
-    [ -x "$tool" ] || { echo "$0: $tool not built (make bench builds it)" >&2; exit 2; }
+for tool in "$plain" "$exact_rows"; do
+    [ -x "$tool" ] || bk_fail 2 "$tool not built (make bench builds it)"
 done
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+bk_temp_dir tmp
 mkdir -p "$out"
 
 repeats=7

@@ -7,23 +7,25 @@
 # Coulomb) and cvode_bdf.  Each run is one process timed by /usr/bin/time: CPU (user + sys)
 # and peak resident memory.  Every N up to 1e5 runs the same simulated window (t_end = 2 s,
 # the config's), so each size sees the same physics; N = 1e6 runs one short window.
-#
-#   scripts/bench_scaling.sh [--quick | --plot-only] OUTDIR
-# writes OUTDIR/scaling.tsv, scaling_slopes.tsv (least-squares slope of log CPU per
+# usage: scripts/bench_scaling.sh [--quick | --plot-only] OUTDIR
+# Writes OUTDIR/scaling.tsv, scaling_slopes.tsv (least-squares slope of log CPU per
 # transition against log N over the full-window sizes, and the ratio at 1e5 over 1e3),
 # scaling.png and scaling_memory.png; and peak memory against the length of a run on the
 # random chain (scaling_run_length.tsv, scaling_run_length.png): a long run's memory must
 # follow the chain, not the run.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+cd "$BK_REPO"
 quick=0 plot_only=0
 case "${1:-}" in
     --quick) quick=1; shift ;;
     --plot-only) plot_only=1; shift ;;
+    -h|--help) bk_help ;;
 esac
-out=${1:?usage: scripts/bench_scaling.sh [--quick | --plot-only] OUTDIR}
+[ $# -ge 1 ] || bk_usage "missing OUTDIR"
+out=$1
 mkdir -p "$out"
-[ -x /usr/bin/time ] || { echo "bench_scaling.sh: needs /usr/bin/time (Debian package time)" >&2; exit 1; }
+bk_need_command /usr/bin/time time
 
 config=configs/chains/bk1000_coulomb.ini
 methods=(exact gsl_rk8pd cvode_bdf)
@@ -47,11 +49,11 @@ else
     long_n=100000; lengths=(0.5 1 2); long_big=1
 fi
 
-scratch=$(mktemp -d)
-trap 'rm -rf "$scratch"' EXIT
+bk_temp_dir scratch
 
 tsv=$out/scaling.tsv
 if [ $plot_only = 0 ]; then
+    bk_find_bksim bksim
     scripts/machine_info.sh > "$out/scaling_machine.txt"
     printf 'chain\tn_blocks\tmethod\tt_end_s\tstatus\ttransitions\tcpu_s\trepeats\tcpu_per_transition_s\tpeak_rss_mb\tsteps\trhs_evals\n' > "$tsv"
 
@@ -62,7 +64,7 @@ if [ $plot_only = 0 ]; then
         [ "$chain" = uniform ] && extra=(--set block.x_init_random=0)
         local log=$scratch/log
         while :; do
-            /usr/bin/time -f 'TIME %U %S %M' ./bksim run "$config" --set model.n_blocks="$n" \
+            /usr/bin/time -f 'TIME %U %S %M' "$bksim" run "$config" --set model.n_blocks="$n" \
                 --set output.interval=0 --set solver.method="$method" --set run.t_end="$t_end" \
                 --set output.path="$scratch/run.h5" "${extra[@]}" > "$log" 2>&1 || status=failed
             rm -f "$scratch/run.h5"

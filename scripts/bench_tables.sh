@@ -3,9 +3,15 @@
 # README's "Choosing a solver" quotes them): CPU and error of every back-end at rtol 1e-8,
 # the references' uncertainty, CPU per transition against chain length with the fitted
 # slopes, and the phase drift over 1e4 cycles.
+# usage: scripts/bench_tables.sh [DIR]   (DIR holds the TSVs; default bench)
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+case ${1:-} in -h|--help) bk_help ;; esac
 dir=${1:-bench}
 results=$dir/results.tsv
+for table in "$results" "$dir/scaling.tsv" "$dir/scaling_slopes.tsv" "$dir/long_run.tsv"; do
+    bk_need_file "$table" "file (scripts/bench.sh writes it)" 2
+done
 
 # Cell: CPU in ms (error in m); "†" marks a run whose stick-slip events differ from the
 # reference's; an error below the reference's uncertainty is shown as "< uncertainty".

@@ -10,37 +10,32 @@
 #   t_start  n_blocks  ruptures
 # usage: event_ruptures.sh [--table] FILE.h5
 set -euo pipefail
-me=event_ruptures.sh
-bksim=${BKSIM:-./bksim}
-[ -n "${BKSIM:-}" ] || [ -x "$bksim" ] || bksim="$(dirname "$0")/../bksim"
-
-usage() { echo "usage: $me [--table] FILE.h5" >&2; exit 2; }
-fail() { echo "$me: $*" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
 table=0; file=""
-while [ $# -gt 0 ]; do
-    case $1 in
-        --table) table=1; shift ;;
-        -h|--help) sed -n '2,11s/^# \{0,1\}//p' "$0"; exit 0 ;;
-        -*) echo "$me: unknown option '$1'" >&2; usage ;;
-        *) [ -z "$file" ] || { echo "$me: unexpected argument '$1'" >&2; usage; }
-           file=$1; shift ;;
+for arg in "$@"; do
+    case $arg in
+        --table) table=1 ;;
+        -h|--help) bk_help ;;
+        -*) bk_usage "unknown option '$arg'" ;;
+        *) [ -z "$file" ] || bk_usage "unexpected argument '$arg'"
+           file=$arg ;;
     esac
 done
-[ -n "$file" ] || { echo "$me: missing FILE.h5" >&2; usage; }
-[ -f "$file" ] || fail "$file: no such file"
-[ -x "$bksim" ] || fail "no bksim binary at $bksim (build it with make, or set BKSIM)"
+[ -n "$file" ] || bk_usage "missing FILE.h5"
+bk_need_file "$file"
+bk_find_bksim bksim
 
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-"$bksim" info "$file" > "$tmp/info" 2> "$tmp/err" || [ $? -eq 3 ] || fail "$(cat "$tmp/err")"
+bk_temp_dir tmp
+"$bksim" info "$file" > "$tmp/info" 2> "$tmp/err" || [ $? -eq 3 ] || bk_fail 1 "$(cat "$tmp/err")"
 n=$(awk '$1 == "n_blocks" {print $2; exit}' "$tmp/info")
 boundary=$(awk '$1 == "boundary" && $2 == "=" {print $3; exit}' "$tmp/info")
-[[ $n =~ ^[0-9]+$ ]] || fail "$file: no n_blocks in bksim info"
-"$bksim" export "$file" --events > "$tmp/events.tsv" 2> "$tmp/err" || fail "$(cat "$tmp/err")"
+[[ $n =~ ^[0-9]+$ ]] || bk_fail 1 "$file: no n_blocks in bksim info"
+"$bksim" export "$file" --events > "$tmp/events.tsv" 2> "$tmp/err" || bk_fail 1 "$(cat "$tmp/err")"
 "$bksim" export "$file" --transitions > "$tmp/transitions.tsv" 2> "$tmp/err" ||
-    fail "$(cat "$tmp/err")"
+    bk_fail 1 "$(cat "$tmp/err")"
 [ "$(grep -vc '^#' "$tmp/transitions.tsv")" -gt 0 ] ||
-    fail "$file: /transitions is empty (run with [output] transitions = true)"
+    bk_fail 1 "$file: /transitions is empty (run with [output] transitions = true)"
 
 # Events (t_start t_end n_blocks complete) in order, then transitions in time order: each
 # onset (to != 0) belongs to the event whose interval holds its time.

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The machine a benchmark ran on, for bench/machine.txt and bench/scaling_machine.txt.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+bk_find_bksim bksim
 echo "date: $(date -u +%Y-%m-%dT%H:%MZ)"
 echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')"
 echo "cores: $(nproc)"
@@ -10,4 +11,4 @@ echo "os: $(. /etc/os-release && echo "$PRETTY_NAME")"
 echo "compiler: $(${CC:-cc} --version | head -1)"
 echo "sundials: $(grep -m1 SUNDIALS_VERSION /usr/include/sundials/sundials_config.h | cut -d'"' -f2)"
 echo "gsl: $(pkg-config --modversion gsl)"
-echo "bksim: $(./bksim --version)"
+echo "bksim: $("$bksim" --version)"

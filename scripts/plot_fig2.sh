@@ -3,18 +3,12 @@
 # under a prescribed slip-rate schedule.
 # usage: plot_fig2.sh [--format png|pdf|svg] [--block I] OUT RUN.h5 [L0 in m, default 2e-5]
 set -euo pipefail
-here=$(dirname "$0")
-source "$here/plot_lib.sh"
-bksim=${BKSIM:-./bksim}
-plot_setup "$0" 2,4 2 "$@"
-set -- "${PLOT_ARGS[@]}"
-terminal=$PLOT_TERMINAL
-block=$PLOT_BLOCK
-out=$1; run=$2; L0=${3:-2e-5}
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-"$bksim" export "$run" --datasets time,x,v,cof --block "$block" > "$tmp/data"
+source "$(dirname "${BASH_SOURCE[0]}")/plot_lib.sh"
+plot_setup 2 "$@"
+out=${PLOT_ARGS[0]}; run=${PLOT_ARGS[1]}; L0=${PLOT_ARGS[2]:-2e-5}
+"$bksim" export "$run" --datasets time,x,v,cof --block "$PLOT_BLOCK" > "$tmp/data"
 gnuplot <<GP
-set terminal $terminal
+set terminal $PLOT_TERMINAL
 set output '$out'
 set title 'Figure 2: rate-and-state COF under velocity steps 1 → 10 → 1 mm/s'
 set grid

@@ -7,21 +7,16 @@
 #   --block I  the block to draw (default 0)
 # The driver (grey) is taken from the first run.  Data come through `bksim export`.
 set -euo pipefail
-here=$(dirname "$0")
-source "$here/plot_lib.sh"
-bksim=${BKSIM:-./bksim}
-plot_setup "$0" 2,9 3 "$@"
+source "$(dirname "${BASH_SOURCE[0]}")/plot_lib.sh"
+plot_setup 3 "$@"
 set -- "${PLOT_ARGS[@]}"
-terminal=$PLOT_TERMINAL
-block=$PLOT_BLOCK
 out=$1; title=$2; shift 2
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 
 pos_plot=""; vel_plot=""; k=0
 for spec in "$@"; do
     IFS=: read -r file label color <<<"$spec"
     # Column 5: driver velocity by finite differences over rows at least 1 us apart.
-    "$bksim" export "$file" --datasets time,driver,x,v --block "$block" |
+    "$bksim" export "$file" --datasets time,driver,x,v --block "$PLOT_BLOCK" |
         awk '/^#/ {next} { if (n++ && $1 - t > 1e-6) u = ($2 - d) / ($1 - t)
                            if (n == 1 || $1 - t > 1e-6) { t = $1; d = $2 }
                            print $0, (n > 1 ? u : "NaN") }' > "$tmp/$k.dat"
@@ -35,22 +30,13 @@ for spec in "$@"; do
 done
 
 gnuplot <<GP
-set terminal $terminal
-set output '$out'
-set multiplot layout 2,1 title '$title'
-set grid
-${XRANGE:+set xrange [$XRANGE]}
-set offsets 0, 0, graph 0.05, graph 0.05
-set key outside right top
-# Fixed margins: panels line up whatever their legends' widths.
-set lmargin at screen 0.09
-set rmargin at screen 0.80
-set ylabel 'position, block $block (mm)'
+$(plot_panels "$out" "$title" 2 0.05)
+set ylabel 'position, block $PLOT_BLOCK (mm)'
 set format x ''
 plot $pos_plot
 set format x '%g'
 set xlabel 'time (s)'
-set ylabel 'velocity, block $block (mm/s)'
+set ylabel 'velocity, block $PLOT_BLOCK (mm/s)'
 plot $vel_plot
 unset multiplot
 GP

@@ -1,56 +1,93 @@
-# Shared by the plot scripts: options every figure takes.  Sourced, not run.
+# shellcheck shell=bash
+# What plot scripts share beyond lib.sh (sourced here: a plot script sources only this):
+# plot_setup and plot_panels for the paper figures (plot_cof.sh, plot_kinematics.sh,
+# plot_fig2.sh); plot_file_option and plot_file_setup for the figures of one output file
+# (plot_mfd.sh, plot_slip_map.sh).  Sourced, not run.
 
-# The gnuplot terminal for --format png|pdf|svg (cairo terminals, 1200x800 at 13 pt).
-plot_terminal() {
-    case $1 in
-        png) echo "pngcairo size 1200,800 font 'Sans,13' noenhanced" ;;
-        pdf) echo "pdfcairo size 10in,6.67in font 'Sans,11' linewidth 0.6 noenhanced" ;;
-        svg) echo "svg size 1200,800 font 'Sans,13' background rgb 'white' noenhanced" ;;
-        *) echo "--format must be png, pdf or svg, got '$1'" >&2; return 2 ;;
-    esac
-}
+# shellcheck source=lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
-# A block index: a whole number >= 0.
-plot_check_block() {
-    [[ $1 =~ ^[0-9]+$ ]] || { echo "--block needs a block index >= 0, got '$1'" >&2; return 2; }
-}
-
-# plot_options "$@": the options every paper figure takes, --format F and --block I, up to
-# the first argument that is none.  Sets PLOT_TERMINAL, PLOT_BLOCK and PLOT_SHIFT (how many
-# arguments it took).  Returns 2 on a bad or unknown option (said on stderr), 3 for --help.
-plot_options() {
-    local format=png
+# plot_setup MIN_ARGS "$@": the options every paper figure takes, --format F and --block I, up
+# to the first argument that is none; -h/--help prints the script's help; a bad or unknown
+# option or fewer than MIN_ARGS arguments is a usage error (exit 2).  Sets PLOT_TERMINAL (the
+# cairo terminal, noenhanced), PLOT_BLOCK, PLOT_ARGS (the arguments after the options), and
+# bksim (the binary) and tmp (a temporary directory, removed at exit).
+plot_setup() {
+    local min=$1 format=png
+    shift
     PLOT_BLOCK=0
-    PLOT_SHIFT=0
     while [ $# -gt 0 ]; do
         case $1 in
             --format|--block)
-                [ $# -ge 2 ] || { echo "$1 needs a value" >&2; return 2; }
+                bk_need_value $# "$1"
                 if [ "$1" = --format ]; then format=$2; else PLOT_BLOCK=$2; fi
-                shift 2
-                PLOT_SHIFT=$((PLOT_SHIFT + 2)) ;;
-            -h|--help) return 3 ;;
-            -*) echo "unknown option '$1'" >&2; return 2 ;;
+                shift 2 ;;
+            -h|--help) bk_help ;;
+            -*) bk_usage "unknown option '$1'" ;;
             *) break ;;
         esac
     done
-    PLOT_TERMINAL=$(plot_terminal "$format") || return 2
-    plot_check_block "$PLOT_BLOCK" || return 2
+    bk_terminal PLOT_TERMINAL "$format"
+    PLOT_TERMINAL+=" noenhanced"
+    bk_check_whole --block "$PLOT_BLOCK" "a block index" 0
+    [ $# -ge "$min" ] || bk_usage
+    PLOT_ARGS=("$@")
+    bk_find_bksim bksim
+    bk_temp_dir tmp
 }
 
-# plot_setup SCRIPT HELP_LINES MIN_ARGS "$@": the start every plot script shares.  Parses the
-# options (plot_options); --help prints SCRIPT's comment lines HELP_LINES (a sed range) and
-# exits 0; a bad option or fewer than MIN_ARGS arguments print the usage line and exit 2.
-# Sets PLOT_TERMINAL, PLOT_BLOCK and PLOT_ARGS (the arguments after the options).
-plot_setup() {
-    local script=$1 help=$2 min=$3 status=0
-    shift 3
-    plot_options "$@" || status=$?
-    [ $status -eq 3 ] && { sed -n "${help}s/^# \{0,1\}//p" "$script"; exit 0; }
-    shift "$PLOT_SHIFT"
-    if [ $status -ne 0 ] || [ $# -lt "$min" ]; then
-        sed -n 's/^# usage: /usage: /p' "$script" >&2
-        exit 2
-    fi
-    PLOT_ARGS=("$@")
+# plot_panels OUT TITLE ROWS MARGIN: the start of a gnuplot script drawing ROWS panels stacked
+# in one column to OUT (PLOT_TERMINAL), under TITLE: grids, legends outside on the right, the
+# same left and right margins for every panel (so that they line up whatever their legends'
+# widths), MARGIN (a fraction of the panel) above and below the data, and time zoomed to
+# $XRANGE (lo:hi in s) when set.  The panels and "unset multiplot" follow.
+plot_panels() {
+    cat <<GP
+set terminal $PLOT_TERMINAL
+set output '$1'
+set multiplot layout $3,1 title '$2'
+set grid
+${XRANGE:+set xrange [$XRANGE]}
+set offsets 0, 0, graph $4, graph $4
+set key outside right top
+# Fixed margins: panels line up whatever their legends' widths.
+set lmargin at screen 0.09
+set rmargin at screen 0.80
+GP
+}
+
+PLOT_FORMAT=png PLOT_OUTDIR="" PLOT_FILE=""
+# plot_file_option "$@": one option or argument of a figure of FILE.h5: --format F (or
+# --format=F), -o/--output OUTDIR, -h/--help, or FILE.h5 itself (once); anything else is a
+# usage error.  Sets PLOT_FORMAT, PLOT_OUTDIR or PLOT_FILE, and PLOT_SHIFT (how many arguments
+# it took).
+plot_file_option() {
+    PLOT_SHIFT=1
+    case $1 in
+        --format) bk_need_value $# "$1"; PLOT_FORMAT=$2; PLOT_SHIFT=2 ;;
+        --format=*) PLOT_FORMAT=${1#--format=} ;;
+        -o|--output) bk_need_value $# "$1"; PLOT_OUTDIR=$2; PLOT_SHIFT=2 ;;
+        -h|--help) bk_help ;;
+        -*) bk_usage "unknown option '$1'" ;;
+        *) [ -z "$PLOT_FILE" ] || bk_usage "unexpected argument '$1'"
+           PLOT_FILE=$1 ;;
+    esac
+}
+
+# plot_file_setup: after the options: FILE.h5 given (else a usage error), the format known
+# (PLOT_TERMINAL, noenhanced), FILE readable, gnuplot and bksim there.  Sets file, format,
+# terminal, bksim, outdir (default FILE's directory, created), stem (FILE's name without .h5
+# and .part) and tmp (a temporary directory, removed at exit).
+plot_file_setup() {
+    [ -n "$PLOT_FILE" ] || bk_usage "missing FILE.h5"
+    file=$PLOT_FILE format=$PLOT_FORMAT
+    bk_terminal terminal "$format"
+    terminal+=" noenhanced"
+    bk_need_file "$file"
+    bk_need_command gnuplot gnuplot-nox
+    bk_find_bksim bksim
+    outdir=${PLOT_OUTDIR:-$(dirname "$file")}
+    mkdir -p "$outdir" || bk_fail 1 "$outdir: cannot create the output directory"
+    stem=$(basename "$file"); stem=${stem%.part}; stem=${stem%.h5}
+    bk_temp_dir tmp
 }

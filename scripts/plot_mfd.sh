@@ -13,48 +13,19 @@
 # Optional XRANGE=lo:hi (s) zooms the space-time plot in time.
 # usage: plot_mfd.sh [--format png|pdf|svg] [-o OUTDIR] FILE.h5
 set -euo pipefail
-me=plot_mfd.sh
-bksim=${BKSIM:-./bksim}
-# Run from elsewhere, use the build next to this script.
-[ -n "${BKSIM:-}" ] || [ -x "$bksim" ] || bksim="$(dirname "$0")/../bksim"
-
-usage() { echo "usage: $me [--format png|pdf|svg] [-o OUTDIR] FILE.h5" >&2; exit 2; }
-fail() { echo "$me: $*" >&2; exit 1; }
-
-format=png; outdir=""; file=""
+source "$(dirname "${BASH_SOURCE[0]}")/plot_lib.sh"
 while [ $# -gt 0 ]; do
-    case $1 in
-        --format) [ $# -ge 2 ] || usage; format=$2; shift 2 ;;
-        --format=*) format=${1#--format=}; shift ;;
-        -o|--output) [ $# -ge 2 ] || usage; outdir=$2; shift 2 ;;
-        -h|--help) sed -n '2,14s/^# \{0,1\}//p' "$0"; exit 0 ;;
-        -*) echo "$me: unknown option '$1'" >&2; usage ;;
-        *) [ -z "$file" ] || { echo "$me: unexpected argument '$1'" >&2; usage; }
-           file=$1; shift ;;
-    esac
+    plot_file_option "$@"
+    shift "$PLOT_SHIFT"
 done
-[ -n "$file" ] || { echo "$me: missing FILE.h5" >&2; usage; }
-case $format in
-    png) terminal="pngcairo size 1200,800 font 'Sans,13'" ;;
-    pdf) terminal="pdfcairo size 10in,6.67in font 'Sans,11' linewidth 0.6" ;;
-    svg) terminal="svg size 1200,800 font 'Sans,13' background rgb 'white'" ;;
-    *) echo "$me: --format must be png, pdf or svg, got '$format'" >&2; usage ;;
-esac
-[ -e "$file" ] || fail "$file: no such file"
-[ -f "$file" ] || fail "$file: not a regular file"
-command -v gnuplot >/dev/null 2>&1 || fail "needs gnuplot (Debian package gnuplot-nox)"
-[ -x "$bksim" ] || fail "no bksim binary at $bksim (build it with make, or set BKSIM)"
-outdir=${outdir:-$(dirname "$file")}
-mkdir -p "$outdir" || fail "$outdir: cannot create the output directory"
-stem=$(basename "$file"); stem=${stem%.part}; stem=${stem%.h5}
+plot_file_setup
 mfd_out="$outdir/${stem}_mfd.$format"
 st_out="$outdir/${stem}_spacetime.$format"
 
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 "$bksim" export "$file" --events > "$tmp/events.tsv" 2> "$tmp/err" ||
-    fail "$(cat "$tmp/err")"
+    bk_fail 1 "$(cat "$tmp/err")"
 "$bksim" stats "$file" --json --tsv "$tmp/stats" > "$tmp/stats.json" 2> "$tmp/err" ||
-    fail "$(cat "$tmp/err")"
+    bk_fail 1 "$(cat "$tmp/err")"
 
 # A top-level value of the JSON report (the first occurrence of the key): a number, or
 # null when bksim could not estimate it; json_note gives a *_note string.
@@ -64,7 +35,7 @@ n_rows=$(json n_rows); n_events=$(json n_events)
 n_incomplete=$(json n_incomplete); n_nonfinite=$(json n_nonfinite)
 n_mc=$(json n_above_mc); mc=$(json mc); b=$(json b_value); b_err=$(json b_value_error); a=$(json a_value)
 dm=$(json bin); m_max=$(json magnitude_max)
-[ "$n_rows" -gt 0 ] || fail "$file: /events is empty: nothing to plot"
+[ "$n_rows" -gt 0 ] || bk_fail 1 "$file: /events is empty: nothing to plot"
 
 # The chain's length (bksim info; its exit status says whether the run finished, which
 # does not matter here), else the largest block an event reached.
@@ -74,8 +45,6 @@ if ! [[ $n_blocks =~ ^[0-9]+$ ]]; then
         "$tmp/events.tsv")
 fi
 
-# Text inside a single-quoted gnuplot string (a quote doubled).
-gpq() { local s=$1 q="'"; printf '%s' "${s//$q/$q$q}"; }
 # Numbers as text: a minus sign, not a hyphen.
 num() { LC_ALL=C printf "%.${2}${3:-f}" "$1" | sed 's/^-/−/'; }
 
@@ -90,7 +59,7 @@ if [ "$b" != null ]; then
     fit_title="Gutenberg–Richter fit for M ≥ Mc: log₁₀ N = a − b M, b = $(num "$b" 3)${b_err_text}, a = $(num "$a" 3) ($n_mc events)"
     fit_plot=", [x=$mc:$m_max + $dm/2] 10**($a - $b*x) with lines lw 2.5 lc rgb '#d62728' title '$fit_title'"
 else
-    fit_plot=", NaN with lines lw 2.5 lc rgb '#d62728' title 'no Gutenberg–Richter fit: $(gpq "$(json_note b_value_note)")'"
+    fit_plot=", NaN with lines lw 2.5 lc rgb '#d62728' title 'no Gutenberg–Richter fit: $(bk_gp_quote "$(json_note b_value_note)")'"
 fi
 mc_arrow=""; mc_plot=""
 if [ "$mc" != null ]; then
@@ -105,11 +74,11 @@ mfd_x=$(awk -v mc="$mc" -v dm="$dm" '!/^#/ {if (!n++) lo = hi = $1; if ($1 < lo)
          printf "%.10g:%.10g", lo - dm, hi + dm}' "$tmp/stats/mfd.tsv")
 mfd_ymax=$(awk '!/^#/ && $3 > m {m = $3} END {print (2 * m > 10 ? 2 * m : 10)}' \
            "$tmp/stats/mfd.tsv")
-gnuplot <<GP || fail "gnuplot failed drawing $mfd_out"
+gnuplot <<GP || bk_fail 1 "gnuplot failed drawing $mfd_out"
 set encoding utf8
-set terminal $terminal noenhanced
-set output '$(gpq "$mfd_out")'
-set title '$(gpq "$stem"): magnitude-frequency distribution' . "\n" . '$(gpq "$subtitle")'
+set terminal $terminal
+set output '$(bk_gp_quote "$mfd_out")'
+set title '$(bk_gp_quote "$stem"): magnitude-frequency distribution' . "\n" . '$(bk_gp_quote "$subtitle")'
 set grid lc rgb '#c0c0c0' lw 1 dt 3
 set xlabel 'magnitude M'
 set ylabel 'number of events N'
@@ -125,7 +94,7 @@ plot '$tmp/stats/mfd.tsv' using 1:(\$3 > 0 ? \$3 : NaN) with linespoints pt 7 ps
      $fit_plot $mc_plot
 GP
 else
-    echo "$me: $file: no complete event with a finite magnitude: no $mfd_out" >&2
+    bk_warn "$file: no complete event with a finite magnitude: no $mfd_out"
 fi
 
 # ------------------------------------------------------------- (b) space-time ---
@@ -154,11 +123,11 @@ zero_plot=""
     zero_plot=", '$tmp/zero.dat' using 1:2:(0):(\$3 - \$2) with vectors nohead lw 2 lc rgb '#999999' title 'zero potency (M = −∞)'"
 wrap_note=""
 [ "$n_wrap" -eq 0 ] || wrap_note=", $n_wrap wrapping past block 0 (drawn as two segments)"
-gnuplot <<GP || fail "gnuplot failed drawing $st_out"
+gnuplot <<GP || bk_fail 1 "gnuplot failed drawing $st_out"
 set encoding utf8
-set terminal $terminal noenhanced
-set output '$(gpq "$st_out")'
-set title '$(gpq "$stem"): events in space and time' . "\n" . \
+set terminal $terminal
+set output '$(bk_gp_quote "$st_out")'
+set title '$(bk_gp_quote "$stem"): events in space and time' . "\n" . \
           '$n_rows events$wrap_note; a segment spans blocks left..right at t_start'
 set xlabel 'event start time t_start [s]'
 set ylabel 'block'

@@ -12,54 +12,27 @@
 # OUTDIR defaults to FILE's directory.
 # usage: plot_slip_map.sh [--format png|pdf|svg] [-o OUTDIR] [--event K | --largest] FILE.h5
 set -euo pipefail
-me=plot_slip_map.sh
-here=$(dirname "$0")
-# shellcheck source-path=SCRIPTDIR source=plot_lib.sh disable=SC1091 # followed with -x
-source "$here/plot_lib.sh"
-bksim=${BKSIM:-./bksim}
-# Run from elsewhere, use the build next to this script.
-[ -n "${BKSIM:-}" ] || [ -x "$bksim" ] || bksim="$here/../bksim"
-
-usage() { echo "usage: $me [--format png|pdf|svg] [-o OUTDIR] [--event K | --largest] FILE.h5" >&2; exit 2; }
-fail() { echo "$me: $*" >&2; exit 1; }
-
-format=png; outdir=""; file=""; event=""
+source "$(dirname "${BASH_SOURCE[0]}")/plot_lib.sh"
+event=""
 while [ $# -gt 0 ]; do
     case $1 in
-        --format) [ $# -ge 2 ] || usage; format=$2; shift 2 ;;
-        --format=*) format=${1#--format=}; shift ;;
-        -o|--output) [ $# -ge 2 ] || usage; outdir=$2; shift 2 ;;
-        --event) [ $# -ge 2 ] || usage; event=$2; shift 2 ;;
+        --event) bk_need_value $# "$1"; event=$2; shift 2 ;;
         --event=*) event=${1#--event=}; shift ;;
         --largest) event=""; shift ;;
-        -h|--help) sed -n '2,13s/^# \{0,1\}//p' "$0"; exit 0 ;;
-        -*) echo "$me: unknown option '$1'" >&2; usage ;;
-        *) [ -z "$file" ] || { echo "$me: unexpected argument '$1'" >&2; usage; }
-           file=$1; shift ;;
+        *) plot_file_option "$@"; shift "$PLOT_SHIFT" ;;
     esac
 done
-[ -n "$file" ] || { echo "$me: missing FILE.h5" >&2; usage; }
-terminal=$(plot_terminal "$format" 2>/dev/null) ||
-    { echo "$me: --format must be png, pdf or svg, got '$format'" >&2; usage; }
-[ -z "$event" ] || [[ $event =~ ^[0-9]+$ ]] ||
-    { echo "$me: --event needs an event row >= 0, got '$event'" >&2; usage; }
-[ -e "$file" ] || fail "$file: no such file"
-[ -f "$file" ] || fail "$file: not a regular file"
-command -v gnuplot >/dev/null 2>&1 || fail "needs gnuplot (Debian package gnuplot-nox)"
-[ -x "$bksim" ] || fail "no bksim binary at $bksim (build it with make, or set BKSIM)"
-outdir=${outdir:-$(dirname "$file")}
-mkdir -p "$outdir" || fail "$outdir: cannot create the output directory"
-stem=$(basename "$file"); stem=${stem%.part}; stem=${stem%.h5}
-
-tmp=$(mktemp -d); partial=""
-trap 'rm -rf "$tmp"; [ -z "$partial" ] || rm -f "$partial"' EXIT
+[ -z "$event" ] || bk_check_whole --event "$event" "an event row" 0
+plot_file_setup
+partial=""
+bk_at_exit '[ -z "$partial" ] || rm -f "$partial"'
 "$bksim" export "$file" --events > "$tmp/events.tsv" 2> "$tmp/err" ||
-    fail "$(cat "$tmp/err")"
+    bk_fail 1 "$(cat "$tmp/err")"
 
 # The event: row K, or the largest finite potency (the first of equals; row 0 if none is
 # finite).  Its fields, tab-separated, go to the shell in one read.
 n_events=$(awk '!/^#/' "$tmp/events.tsv" | wc -l)
-[ "$n_events" -gt 0 ] || fail "$file: /events is empty: no event to map"
+[ "$n_events" -gt 0 ] || bk_fail 1 "$file: /events is empty: no event to map"
 if [ -z "$event" ]; then
     event=$(awk -F'\t' '/^#/ {next}
         {k = n++; p = $8 + 0}
@@ -69,7 +42,7 @@ if [ -z "$event" ]; then
 else
     event=$(echo "$event" | sed 's/^0*//; s/^$/0/')
     if [ ${#event} -gt 15 ] || [ "$event" -ge "$n_events" ]; then
-        fail "$file: --event $event out of range: /events has $n_events rows (0..$((n_events - 1)))"
+        bk_fail 1 "$file: --event $event out of range: /events has $n_events rows (0..$((n_events - 1)))"
     fi
     what=""
 fi
@@ -81,13 +54,13 @@ IFS=$'\t' read -r t_start t_end first_block ev_blocks left right _ _ magnitude _
 # A lattice line that does not read so is an error, never a chain drawn in its place.
 info=$({ "$bksim" info "$file" 2>/dev/null || true; })
 n_blocks=$(awk '$1 == "n_blocks" {print $2; exit}' <<<"$info")
-[[ ${n_blocks:-} =~ ^[0-9]+$ ]] || fail "$file: bksim info gives no n_blocks"
+[[ ${n_blocks:-} =~ ^[0-9]+$ ]] || bk_fail 1 "$file: bksim info gives no n_blocks"
 shape=$(awk '$1 == "lattice" {
         print ($2 ~ /^[0-9]+$/ && $3 == "x" && $4 ~ /^[0-9]+$/) ? $2 " " $4 : "unreadable"; exit
     }' <<<"$info")
-[ "$shape" != unreadable ] || fail "$file: cannot read the lattice's shape from bksim info: $(grep '^lattice' <<<"$info")"
+[ "$shape" != unreadable ] || bk_fail 1 "$file: cannot read the lattice's shape from bksim info: $(grep '^lattice' <<<"$info")"
 read -r rows cols <<<"${shape:-1 $n_blocks}"
-[ "$((rows * cols))" -eq "$n_blocks" ] || fail "$file: a $rows x $cols lattice of $n_blocks blocks"
+[ "$((rows * cols))" -eq "$n_blocks" ] || bk_fail 1 "$file: a $rows x $cols lattice of $n_blocks blocks"
 
 # A finished event's slip is exact from /transitions, where the run kept them: a block is
 # stuck between its episodes, so x at its last transition in the event minus x at its first
@@ -152,19 +125,17 @@ export_rc=$(cat "$tmp/export_rc" 2>/dev/null || echo 0)
 early=0
 [ "$out_rc" -ne 0 ] || read -r t_before t_after n rows cols early < "$tmp/rows.txt"
 if [ "$export_rc" -ne 0 ] && [ "$early" -ne 1 ]; then
-    [ -s "$tmp/err" ] || fail "bksim export $file --datasets time,x failed (status $export_rc)"
-    fail "$(cat "$tmp/err")"
+    [ -s "$tmp/err" ] || bk_fail 1 "bksim export $file --datasets time,x failed (status $export_rc)"
+    bk_fail 1 "$(cat "$tmp/err")"
 fi
 case $out_rc in
     0) ;;
-    3) fail "$file: no sample rows in /time: nothing to map" ;;
-    4) fail "$file: cannot read the rows of 'bksim export --datasets time,x'" ;;
-    5) fail "$file: the x columns do not make the ${rows} x ${cols} lattice bksim info reports" ;;
-    *) fail "awk failed reading the samples of $file" ;;
+    3) bk_fail 1 "$file: no sample rows in /time: nothing to map" ;;
+    4) bk_fail 1 "$file: cannot read the rows of 'bksim export --datasets time,x'" ;;
+    5) bk_fail 1 "$file: the x columns do not make the ${rows} x ${cols} lattice bksim info reports" ;;
+    *) bk_fail 1 "awk failed reading the samples of $file" ;;
 esac
 
-# Text inside a single-quoted gnuplot string (a quote doubled).
-gpq() { local s=$1 q="'"; printf '%s' "${s//$q/$q$q}"; }
 g() { LC_ALL=C printf "%.${2:-6}g" "$1"; }
 
 # The colour range: from 0 (or the most negative slip) to the largest, never empty.
@@ -191,7 +162,7 @@ box_plot=""
 if [ "$n_pieces" -gt 0 ]; then
     box_title="bounding box, blocks $left..$right"
     [ "$n_pieces" -eq 1 ] || box_title="$box_title (wraps: $n_pieces pieces)"
-    box_plot="NaN with lines lw 3 dt 2 lc rgb '#1f77b4' title '$(gpq "$box_title")', "
+    box_plot="NaN with lines lw 3 dt 2 lc rgb '#1f77b4' title '$(bk_gp_quote "$box_title")', "
 fi
 epi_r=$((first_block / cols)); epi_c=$((first_block % cols))
 
@@ -209,12 +180,12 @@ tics() { if [ "$1" -le 16 ]; then echo "set $2tics 1"; else echo "set $2tics out
 out="$outdir/${stem}_slip_map_$event.$format"
 # Drawn to a hidden file beside the figure, renamed when gnuplot succeeded.
 partial=$(mktemp "$outdir/.${stem}_slip_map_$event.XXXXXX") ||
-    fail "$outdir: cannot write there"
-gnuplot <<GP 2> "$tmp/gp.err" || fail "gnuplot failed drawing $out: $(cat "$tmp/gp.err")"
+    bk_fail 1 "$outdir: cannot write there"
+gnuplot <<GP 2> "$tmp/gp.err" || bk_fail 1 "gnuplot failed drawing $out: $(cat "$tmp/gp.err")"
 set encoding utf8
 set terminal $terminal
-set output '$(gpq "$partial")'
-set title '$(gpq "$title1")' . "\n" . '$(gpq "$title2")'
+set output '$(bk_gp_quote "$partial")'
+set title '$(bk_gp_quote "$title1")' . "\n" . '$(bk_gp_quote "$title2")'
 $ratio
 set xrange [-0.5 : $cols - 0.5]
 set yrange [$rows - 0.5 : -0.5]
@@ -240,6 +211,6 @@ e
 GP
 # mktemp made it private; give it the mode a new file would have.
 chmod "$(printf %o $((0666 & ~0$(umask))))" "$partial" || true
-mv -f "$partial" "$out" || fail "cannot rename $partial to $out"
+mv -f "$partial" "$out" || bk_fail 1 "cannot rename $partial to $out"
 partial=""
 echo "$out"

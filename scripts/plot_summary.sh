@@ -11,45 +11,38 @@
 #                        [--logx] [--logy] [--title TEXT] [--x-transform EXPR]
 #                        [--xlabel TEXT] [--ylabel TEXT] [--y2label TEXT] DIR|SUMMARY.tsv X Y [Y2]
 set -euo pipefail
-me=plot_summary.sh
-usage() { sed -n '/^# usage:/,/^[^#]/p' "$0" | sed '$d; s/^# \{0,1\}//' >&2; exit 2; }
-fail() { echo "$me: $*" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
 format=png; out=""; errors=""; by=""; logx=0; logy=0; title=""; args=()
 transform=x; xlabel=""; ylabel=""; y2label=""
 while [ $# -gt 0 ]; do
     case $1 in
-        --format) [ $# -ge 2 ] || usage; format=$2; shift 2 ;;
+        --format) bk_need_value $# "$1"; format=$2; shift 2 ;;
         --format=*) format=${1#--format=}; shift ;;
-        -o|--output) [ $# -ge 2 ] || usage; out=$2; shift 2 ;;
-        --errors) [ $# -ge 2 ] || usage; errors=$2; shift 2 ;;
-        --by) [ $# -ge 2 ] || usage; by=$2; shift 2 ;;
+        -o|--output) bk_need_value $# "$1"; out=$2; shift 2 ;;
+        --errors) bk_need_value $# "$1"; errors=$2; shift 2 ;;
+        --by) bk_need_value $# "$1"; by=$2; shift 2 ;;
         --logx) logx=1; shift ;;
         --logy) logy=1; shift ;;
-        --title) [ $# -ge 2 ] || usage; title=$2; shift 2 ;;
-        --x-transform) [ $# -ge 2 ] || usage; transform=$2; shift 2 ;;
-        --xlabel) [ $# -ge 2 ] || usage; xlabel=$2; shift 2 ;;
-        --ylabel) [ $# -ge 2 ] || usage; ylabel=$2; shift 2 ;;
-        --y2label) [ $# -ge 2 ] || usage; y2label=$2; shift 2 ;;
-        -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
-        -*) echo "$me: unknown option '$1'" >&2; usage ;;
+        --title) bk_need_value $# "$1"; title=$2; shift 2 ;;
+        --x-transform) bk_need_value $# "$1"; transform=$2; shift 2 ;;
+        --xlabel) bk_need_value $# "$1"; xlabel=$2; shift 2 ;;
+        --ylabel) bk_need_value $# "$1"; ylabel=$2; shift 2 ;;
+        --y2label) bk_need_value $# "$1"; y2label=$2; shift 2 ;;
+        -h|--help) bk_help ;;
+        -*) bk_usage "unknown option '$1'" ;;
         *) args+=("$1"); shift ;;
     esac
 done
-[ ${#args[@]} -ge 3 ] && [ ${#args[@]} -le 4 ] || usage
+[ ${#args[@]} -ge 3 ] && [ ${#args[@]} -le 4 ] || bk_usage
 source=${args[0]} x=${args[1]} y=${args[2]} y2=${args[3]:-}
 [ -d "$source" ] && source=$source/summary.tsv
-[ -f "$source" ] || fail "$source: no such summary (run: bksim summary DIR)"
-case $format in
-    png) terminal="pngcairo size 1200,800 font 'Sans,13'" ;;
-    pdf) terminal="pdfcairo size 10in,6.67in font 'Sans,11' linewidth 0.6" ;;
-    svg) terminal="svg size 1200,800 font 'Sans,13' background rgb 'white'" ;;
-    *) echo "$me: --format must be png, pdf or svg, got '$format'" >&2; usage ;;
-esac
-command -v gnuplot > /dev/null 2>&1 || fail "needs gnuplot (Debian package gnuplot-nox)"
+bk_need_file "$source" "summary (run: bksim summary DIR)"
+bk_terminal terminal "$format"
+bk_need_command gnuplot gnuplot-nox
 out=${out:-$(dirname "$source")/summary_${y}_vs_${x}.$format}
 
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+bk_temp_dir tmp
 # Columns by name; rows sorted by X within each --by group, groups as gnuplot data blocks.
 awk -F'\t' -v x="$x" -v y="$y" -v y2="$y2" -v e="$errors" -v by="$by" -v data="$tmp/data" \
     -v groups="$tmp/groups" -v units="$tmp/units" '
@@ -69,8 +62,8 @@ awk -F'\t' -v x="$x" -v y="$y" -v y2="$y2" -v e="$errors" -v by="$by" -v data="$
           for (k = 1; k <= n; ++k) {
               printf "%s", rows[order[k]] | ("sort -g > " data "." k)
               close("sort -g > " data "." k)
-              print order[k] > groups } }' "$source" || fail "$source: cannot read the columns asked for"
-[ -s "$tmp/groups" ] || fail "$source: no row with both $x and $y"
+              print order[k] > groups } }' "$source" || bk_fail 1 "$source: cannot read the columns asked for"
+[ -s "$tmp/groups" ] || bk_fail 1 "$source: no row with both $x and $y"
 unit_of() { tr ',' '\n' < "$tmp/units" | awk -v c="$1" '{sub(/^ /, "")} $1 == c {print $2}'; }
 label() { local u; u=$(unit_of "$1"); [ -n "$u" ] && [ "$u" != 1 ] && echo "$1 ($u)" || echo "$1"; }
 : > "$tmp/all"
@@ -115,5 +108,5 @@ n_groups=$k
     done < "$tmp/groups"
     echo
 } > "$tmp/plot.gp"
-gnuplot "$tmp/plot.gp" 2> "$tmp/err" || fail "gnuplot: $(cat "$tmp/err")"
+gnuplot "$tmp/plot.gp" 2> "$tmp/err" || bk_fail 1 "gnuplot: $(cat "$tmp/err")"
 echo "$out ($n_groups line$([ "$n_groups" -eq 1 ] || echo s))"

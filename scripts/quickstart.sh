@@ -3,21 +3,22 @@
 #   scripts/quickstart.sh paper   install dependencies, build, run the paper's cases, plot
 #   scripts/quickstart.sh test    install dependencies, build, run the test suite
 # Installs with apt-get (as root, or through sudo); everything else runs as the caller.
+# usage: scripts/quickstart.sh {paper|test}
 set -euo pipefail
-cd "$(dirname "$0")/.."
+# Sourcing needs nothing built: this runs on a machine that has nothing yet.
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+cd "$BK_REPO"
 
 target=${1:-paper}
 case "$target" in
     paper|test|bench|all) ;;
-    *) echo "usage: $0 {paper|test}" >&2; exit 2 ;;
+    -h|--help) bk_help ;;
+    *) bk_usage "unknown job '$target'" ;;
 esac
 
 packages=(build-essential pkg-config libsundials-dev libgsl-dev libhdf5-dev libcmocka-dev
           libinih-dev liblapacke-dev hdf5-tools gnuplot-nox time parallel procps)
-missing=()
-for p in "${packages[@]}"; do
-    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
+mapfile -t missing < <(bk_missing_packages "${packages[@]}")
 if [ ${#missing[@]} -gt 0 ]; then
     echo "quickstart: installing ${missing[*]}"
     as_root=()

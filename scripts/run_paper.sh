@@ -2,8 +2,10 @@
 # The main job: every paper config, its HDF5 file and the paper's Figures 2 and 4-9 under
 # out/paper/, and a one-line summary per case (out/paper/summary.txt).
 set -euo pipefail
-cd "$(dirname "$0")/.."
-bksim=${BKSIM:-./bksim}
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+bk_find_bksim bksim
+export BKSIM=$bksim # the figures' scripts below run the same binary
+cd "$BK_REPO"
 out=out/paper
 mkdir -p "$out"
 rm -f "$out"/*.png "$out"/*.h5 "$out"/*.part

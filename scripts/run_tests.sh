@@ -3,7 +3,10 @@
 # TEST_JOBS=N runs up to N at a time, each one's output printed whole when it ends; the
 # programs whose names are in TEST_ALONE (kills and wall clocks, timed against the machine)
 # then run one at a time.
+# usage: scripts/run_tests.sh LABEL PROGRAM...
 set -u
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+[ $# -ge 1 ] || bk_usage
 label=$1; shift
 jobs=${TEST_JOBS:-1}
 failed=()
@@ -13,8 +16,7 @@ for t in "$@"; do
 done
 [ "$jobs" -gt 1 ] || { alone=("$@"); together=(); }
 
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+bk_temp_dir tmp
 declare -A program_of
 finish_one() {
     local pid status

@@ -6,9 +6,9 @@
 # directory, `bksim summary DIR` gives one table with every run's figures.
 # usage: summary.sh RUN.h5...
 set -uo pipefail
-bksim=${BKSIM:-./bksim}
-[ -x "$bksim" ] || bksim="$(dirname "$0")/../bksim"
-[ $# -gt 0 ] || { echo "usage: summary.sh RUN.h5..." >&2; exit 2; }
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+[ $# -gt 0 ] || bk_usage
+bk_find_bksim bksim
 status=0
 # The largest |value| (abs = 1) or the range of every column but none, of an export.
 columns() {
@@ -23,7 +23,7 @@ for file in "$@"; do
     why=$("$bksim" info "$file" 2>&1 > /dev/null)
     case $? in
         0|3) ;;
-        *) echo "summary.sh: $(head -1 <<< "$why")" >&2; status=1; continue ;;
+        *) bk_warn "$(head -1 <<< "$why")"; status=1; continue ;;
     esac
     slips=$("$bksim" export "$file" --transitions 2> /dev/null |
         awk '!/^#/ && $3 == 0 && $4 != 0 {n++} END {print n+0}') || slips=n/a

@@ -19,45 +19,35 @@
 # Exit status: 0 every point finished; 1 some point failed (sweep.log says which and why);
 # 2 bad usage.
 set -euo pipefail
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/sweep_lib.sh"
-
-usage() {
-    sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//' >&2
-    exit 2
-}
+source "$(dirname "${BASH_SOURCE[0]}")/sweep_lib.sh"
 
 jobs=$(nproc)
 dir=
 plan_only=0
 while [ $# -gt 0 ]; do
     case $1 in
-        -j) [ $# -ge 2 ] || sweep_die "-j needs a number of jobs"; jobs=$2; shift 2 ;;
+        -j) bk_need_value $# "$1" "a number of jobs"; jobs=$2; shift 2 ;;
         -j*) jobs=${1#-j}; shift ;;
-        -o) [ $# -ge 2 ] || sweep_die "-o needs a directory"; dir=$2; shift 2 ;;
+        -o) bk_need_value $# "$1" "a directory"; dir=$2; shift 2 ;;
         --plan) plan_only=1; shift ;;
-        -h|--help) usage ;;
+        -h|--help) bk_help ;;
         --) shift; break ;;
-        -*) sweep_die "unknown option '$1'" ;;
+        -*) bk_usage "unknown option '$1'" ;;
         *) break ;;
     esac
 done
-[ $# -ge 1 ] || sweep_die "missing BASE.ini (see --help)"
-[[ $jobs =~ ^[1-9][0-9]*$ ]] || sweep_die "-j needs a whole number of jobs >= 1, got '$jobs'"
-base=$1
-shift
-[ -n "$dir" ] || dir=out/sweeps/$(basename "$base" .ini)
-
-sweep_plan "$base" "$dir" "$@"
+bk_check_whole -j "$jobs" "a whole number of jobs" 1
+sweep_plan "$dir" "$@"
+dir=$SWEEP_DIR
 [ "$plan_only" -eq 1 ] && { echo "sweep: planned $SWEEP_POINTS points in $dir (points.tsv)"; exit 0; }
 
 command -v parallel > /dev/null ||
-    sweep_die "GNU parallel is not installed (Debian: apt-get install parallel)"
+    bk_fail 2 "GNU parallel is not installed (Debian: apt-get install parallel)"
 echo "sweep: $SWEEP_POINTS points in $dir on $jobs jobs" >&2
 # Each job prints one status line; --line-buffer keeps them whole and in the log as they end.
 status=0
 tail -n +2 "$dir/points.tsv" | cut -f1 |
     parallel --will-cite --quote --jobs "$jobs" --halt never --line-buffer \
-        "$here/sweep_point.sh" "$dir" {} >> "$dir/sweep.log" || status=1
+        "$BK_SCRIPTS/sweep_point.sh" "$dir" {} >> "$dir/sweep.log" || status=1
 sweep_report "$dir" || status=1
 exit $status

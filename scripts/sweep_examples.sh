@@ -6,15 +6,19 @@
 #     its error) against l -> docs/sweep_coupling_b.png.
 # usage: scripts/sweep_examples.sh [-j JOBS] [-o DIR]   (outputs in DIR, default out/sweeps)
 set -euo pipefail
-cd "$(dirname "$0")/.."
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+cd "$BK_REPO"
 jobs=$(nproc); dir=out/sweeps
 while [ $# -gt 0 ]; do
     case $1 in
-        -j) jobs=$2; shift 2 ;;
-        -o) dir=$2; shift 2 ;;
-        *) echo "usage: $0 [-j JOBS] [-o DIR]" >&2; exit 2 ;;
+        -j) bk_need_value $# "$1"; jobs=$2; shift 2 ;;
+        -o) bk_need_value $# "$1"; dir=$2; shift 2 ;;
+        -h|--help) bk_help ;;
+        *) bk_usage "unknown option '$1'" ;;
     esac
 done
+bk_find_bksim bksim
+export BKSIM=$bksim # the sweeps below run the same binary
 scripts/sweep.sh -j "$jobs" -o "$dir/mu_d" configs/paper/case_a_coulomb.ini \
     friction.mu_d=0.05,0.1,0.15,0.2,0.25,0.3,0.35,0.4,0.45,0.5,0.55 run.t_end=10
 scripts/plot_summary.sh -o docs/sweep_mu_d.png --xlabel 'μ_d' --ylabel 'period (s)' \
@@ -25,7 +29,7 @@ scripts/plot_summary.sh -o docs/sweep_mu_d.png --xlabel 'μ_d' --ylabel 'period 
 scripts/sweep.sh -j "$jobs" -o "$dir/coupling" configs/chains/carlson_langer_100.ini \
     model.coupling_stiffness=4,9,16,25,36,49,64,100,144 run.t_end=6000 \
     output.checkpoint_interval=500
-./bksim summary "$dir/coupling" --from 1000
+"$bksim" summary "$dir/coupling" --from 1000
 scripts/plot_summary.sh -o docs/sweep_coupling_b.png --x-transform 'sqrt(x)' \
     --xlabel 'ℓ = √(k_c / k_p)' --ylabel 'b-value (M ≥ Mc), Aki–Utsu ± Shi–Bolt' \
     --errors b_error --title 'Carlson–Langer ring, 100 blocks: b-value against the coupling ℓ' \

@@ -1,49 +1,46 @@
-# Shared by scripts/sweep.sh, scripts/sweep_point.sh and scripts/slurm/*: the grid plan,
-# the bksim binary, the end-of-sweep report.  Sourced, not run.
+# shellcheck shell=bash
+# Shared by scripts/sweep.sh, scripts/sweep_point.sh and scripts/slurm/*, on top of lib.sh
+# (sourced here): the grid plan and the end-of-sweep report.  Every message starts "sweep: ",
+# and every failure exits 2 (bad usage, as sweep.sh documents), a missing bksim too.
+# Sourced, not run; the SLURM jobs source it by the scripts directory submit.sh gives them.
 
-sweep_die() {
-    echo "sweep: $*" >&2
-    exit 2
-}
-
-# The bksim binary as an absolute path: $BKSIM, else the repository's ./bksim, else PATH's.
-sweep_bksim() {
-    local repo candidate
-    repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-    candidate=${BKSIM:-}
-    [ -n "$candidate" ] || { [ -x "$repo/bksim" ] && candidate=$repo/bksim; } ||
-        candidate=$(command -v bksim) || sweep_die "no bksim: build it (make) or set BKSIM"
-    [ -x "$candidate" ] || sweep_die "BKSIM=$candidate is not an executable"
-    echo "$(cd "$(dirname "$candidate")" && pwd)/$(basename "$candidate")"
-}
+# shellcheck source=lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+BK_PROG=sweep
 
 # A value as a file-name part: characters outside [A-Za-z0-9._+-] become '_'.
 sweep_clean() {
     printf '%s' "$1" | tr -c 'A-Za-z0-9._+-' '_'
 }
 
-# sweep_plan BASE DIR KEY=V1,V2 ...: check the arguments, write DIR/base.ini and
+# sweep_plan DIR BASE.ini KEY=V1,V2 ...: check the arguments, write DIR/base.ini and
 # DIR/points.tsv (point, then one column per key), or check that a rerun gives the same
-# ones; sets SWEEP_POINTS.  Point names join the swept keys' key=value (a key with one value
-# is fixed and left out of the name) with ','.
+# ones.  An empty DIR is out/sweeps/<BASE name>.  Sets SWEEP_DIR and SWEEP_POINTS.  Point
+# names join the swept keys' key=value (a key with one value is fixed and left out of the
+# name) with ','.
 sweep_plan() {
-    local base=$1 dir=$2
-    shift 2
-    [ -f "$base" ] || sweep_die "$base: no such config file"
+    local dir=$1
+    shift
+    [ $# -ge 1 ] || bk_usage "missing BASE.ini"
+    local base=$1
+    shift
+    [ -n "$dir" ] || dir=out/sweeps/$(basename "$base" .ini)
+    SWEEP_DIR=$dir
+    bk_need_file "$base" "config file" 2
     local -a keys=() lists=()
     local arg key values
     for arg in "$@"; do
-        [[ $arg == *=* ]] || sweep_die "'$arg' is not KEY=V1,V2,... (e.g. friction.mu_d=0.1,0.2)"
+        [[ $arg == *=* ]] || bk_fail 2 "'$arg' is not KEY=V1,V2,... (e.g. friction.mu_d=0.1,0.2)"
         key=${arg%%=*}
         values=${arg#*=}
         [[ $key =~ ^[A-Za-z_]+(\.[0-9]+)?\.[A-Za-z0-9_]+$ ]] ||
-            sweep_die "'$key' is not a section.key (e.g. friction.mu_d, block.3.mass)"
+            bk_fail 2 "'$key' is not a section.key (e.g. friction.mu_d, block.3.mass)"
         [ -n "$values" ] && [[ $values != *,,* && $values != ,* && $values != *, ]] ||
-            sweep_die "$key: every value must be non-empty, got '$values'"
-        [[ $values != *$'\t'* && $values != *$'\n'* ]] || sweep_die "$key: a value holds a tab or newline"
+            bk_fail 2 "$key: every value must be non-empty, got '$values'"
+        [[ $values != *$'\t'* && $values != *$'\n'* ]] || bk_fail 2 "$key: a value holds a tab or newline"
         local k
         for k in "${keys[@]}"; do
-            [ "$k" != "$key" ] || sweep_die "$key is given twice: list all its values in one argument"
+            [ "$k" != "$key" ] || bk_fail 2 "$key is given twice: list all its values in one argument"
         done
         keys+=("$key")
         lists+=("$values")
@@ -81,28 +78,28 @@ sweep_plan() {
     )
     local dup
     dup=$(tail -n +2 <<< "$plan" | cut -f1 | sort | uniq -d | head -1)
-    [ -z "$dup" ] || sweep_die "two points share the name '$dup' (a value repeated, or values that differ only in characters outside [A-Za-z0-9._+-])"
+    [ -z "$dup" ] || bk_fail 2 "two points share the name '$dup' (a value repeated, or values that differ only in characters outside [A-Za-z0-9._+-])"
     awk -F'\t' 'NR > 1 && length($1) > 200 {exit 1}' <<< "$plan" ||
-        sweep_die "a point's name would pass 200 characters: sweep fewer keys at once"
+        bk_fail 2 "a point's name would pass 200 characters: sweep fewer keys at once"
 
-    mkdir -p "$dir/logs" || sweep_die "$dir: cannot create"
+    mkdir -p "$dir/logs" || bk_fail 2 "$dir: cannot create"
     if [ -e "$dir/base.ini" ]; then
         cmp -s "$base" "$dir/base.ini" ||
-            sweep_die "$dir holds a sweep of another config than $base: use another -o DIR"
+            bk_fail 2 "$dir holds a sweep of another config than $base: use another -o DIR"
     fi
     if [ -e "$dir/points.tsv" ]; then
         [ "$plan" = "$(cat "$dir/points.tsv")" ] ||
-            sweep_die "$dir holds a sweep of another grid (see $dir/points.tsv): use another -o DIR"
+            bk_fail 2 "$dir holds a sweep of another grid (see $dir/points.tsv): use another -o DIR"
     fi
     if [ ! -e "$dir/base.ini" ] || [ ! -e "$dir/points.tsv" ]; then
         # The first point is checked before anything is written: a typo in a key fails here.
         local bksim first
         local -a sets=()
-        bksim=$(sweep_bksim)
+        bk_find_bksim bksim 2
         first=$(sed -n 2p <<< "$plan")
         IFS=$'\t' read -r -a vals <<< "$first"
         for i in "${!keys[@]}"; do sets+=(--set "${keys[$i]}=${vals[$((i + 1))]}"); done
-        "$bksim" check "$base" "${sets[@]}" > /dev/null || sweep_die "the first point's config is refused (above)"
+        "$bksim" check "$base" "${sets[@]}" > /dev/null || bk_fail 2 "the first point's config is refused (above)"
         cp "$base" "$dir/base.ini.tmp" && mv "$dir/base.ini.tmp" "$dir/base.ini"
         echo "$plan" > "$dir/points.tsv.tmp" && mv "$dir/points.tsv.tmp" "$dir/points.tsv"
     fi
@@ -112,7 +109,7 @@ sweep_plan() {
 # After the runs: how many points finished, the summary, a line in sweep.log.  Returns 1
 # when a point has no finished output.
 sweep_report() {
-    local dir=$1 name total=0 finished=0
+    local dir=$1 name total=0 finished=0 bksim
     local -a missing=()
     while IFS= read -r name; do
         total=$((total + 1))
@@ -123,7 +120,8 @@ sweep_report() {
     echo "$line" >> "$dir/sweep.log"
     echo "sweep: $finished of $total points finished in $dir" >&2
     if [ "$finished" -gt 0 ]; then
-        "$(sweep_bksim)" summary "$dir" >&2 || return 1
+        bk_find_bksim bksim 2
+        "$bksim" summary "$dir" >&2 || return 1
     fi
     if [ ${#missing[@]} -ne 0 ]; then
         echo "sweep: ${#missing[@]} points failed or did not run (why: $dir/sweep.log, $dir/logs/)" >&2

@@ -6,9 +6,8 @@
 # DIR/logs/<point>.log.  Exit status 0 when the point is finished, 1 when it failed.
 # usage: scripts/sweep_point.sh DIR POINT
 set -uo pipefail
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/sweep_lib.sh"
-[ $# -eq 2 ] || sweep_die "usage: sweep_point.sh DIR POINT"
+source "$(dirname "${BASH_SOURCE[0]}")/sweep_lib.sh"
+[ $# -eq 2 ] || bk_usage
 dir=$1 name=$2
 out=$dir/$name.h5
 log=$dir/logs/$name.log
@@ -32,7 +31,7 @@ if [ "$found" != 1 ]; then
     printf '%s\t%s\tFAILED: no such point in %s/points.tsv\n' "$(stamp)" "$name" "$dir"
     exit 1
 fi
-bksim=$(sweep_bksim)
+bk_find_bksim bksim 2
 mkdir -p "$dir/logs"
 printf '== %s on %s: bksim run %s -o %s --resume --point %s %s\n' "$(stamp)" "$(hostname)" \
     "$dir/base.ini" "$out" "$name" "${sets[*]}" >> "$log"

@@ -2,9 +2,11 @@
 # Regenerate README.md's config reference (between the keys:begin/keys:end markers) from
 # `bksim keys`, the single source of truth; tests/test_cli.c checks they agree.
 set -euo pipefail
-cd "$(dirname "$0")/.."
-bksim=${BKSIM:-./bksim}
-ref=$(mktemp); trap 'rm -f "$ref"' EXIT
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+bk_find_bksim bksim
+cd "$BK_REPO"
+bk_temp_dir tmp
+ref=$tmp/keys.md
 "$bksim" keys > "$ref"
 awk -v ref="$ref" '
     /<!-- keys:begin -->/ { print; while ((getline line < ref) > 0) print line; skip = 1; next }

@@ -12,32 +12,29 @@
 # Prints the array's and the summary's job ids.  Each task's status lines go to
 # DIR/sweep.log, SLURM's own output to DIR/logs/slurm-<job>_<task>.out.
 set -euo pipefail
-scripts=$(cd "$(dirname "$0")/.." && pwd)
-source "$scripts/sweep_lib.sh"
+source "$(dirname "${BASH_SOURCE[0]}")/../sweep_lib.sh"
+scripts=$BK_SCRIPTS # the jobs are told where the scripts are: SLURM runs copies of them
 
 chunk=1
 dir=
 sbatch_options=
 while [ $# -gt 0 ]; do
     case $1 in
-        -c) [ $# -ge 2 ] || sweep_die "-c needs a number of points"; chunk=$2; shift 2 ;;
-        -o) [ $# -ge 2 ] || sweep_die "-o needs a directory"; dir=$2; shift 2 ;;
-        --sbatch) [ $# -ge 2 ] || sweep_die "--sbatch needs options"; sbatch_options=$2; shift 2 ;;
-        -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//' >&2; exit 2 ;;
-        -*) sweep_die "unknown option '$1'" ;;
+        -c) bk_need_value $# "$1" "a number of points"; chunk=$2; shift 2 ;;
+        -o) bk_need_value $# "$1" "a directory"; dir=$2; shift 2 ;;
+        --sbatch) bk_need_value $# "$1" "options"; sbatch_options=$2; shift 2 ;;
+        -h|--help) bk_help ;;
+        -*) bk_usage "unknown option '$1'" ;;
         *) break ;;
     esac
 done
-[[ $chunk =~ ^[1-9][0-9]*$ ]] || sweep_die "-c needs a whole number of points >= 1, got '$chunk'"
-[ $# -ge 1 ] || sweep_die "missing BASE.ini (see --help)"
-command -v sbatch > /dev/null || sweep_die "no sbatch on PATH: is this a SLURM login node?"
-base=$1
-shift
-[ -n "$dir" ] || dir=out/sweeps/$(basename "$base" .ini)
-sweep_plan "$base" "$dir" "$@"
-dir=$(cd "$dir" && pwd)
+bk_check_whole -c "$chunk" "a whole number of points" 1
+[ $# -ge 1 ] || bk_usage "missing BASE.ini"
+command -v sbatch > /dev/null || bk_fail 2 "no sbatch on PATH: is this a SLURM login node?"
+sweep_plan "$dir" "$@"
+dir=$(cd "$SWEEP_DIR" && pwd)
 tasks=$(( (SWEEP_POINTS + chunk - 1) / chunk ))
-bksim=$(sweep_bksim)
+bk_find_bksim bksim 2
 # shellcheck disable=SC2086 # the extra options are meant to split into words
 array=$(sbatch --parsable --job-name=bksim-sweep --array=0-$((tasks - 1)) --ntasks=1 \
     --output="$dir/logs/slurm-%A_%a.out" --export=ALL,BKSIM="$bksim" $sbatch_options \

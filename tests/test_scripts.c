@@ -1,0 +1,243 @@
+/* The scripts under scripts/ end to end, as a user runs them: summary.sh, the paper's plot
+ * scripts, the catalog's (event_ruptures.sh, plot_mfd.sh, plot_slip_map.sh) and the
+ * benchmarks' smoke runs (bench.sh --quick, bench_output.sh --quick); sweep.sh is
+ * test_sweep.c's.  Runs from the repository root, with ./bksim (or $BKSIM). */
+#define _POSIX_C_SOURCE 200809L
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bk_test.h"
+#include "bksim/bksim.h"
+#include "command.h"
+#include "files.h"
+
+static char tmpdir[256];
+
+static int setup(void **state)
+{
+    (void)state;
+    return make_temp_dir(tmpdir, sizeof tmpdir, "bksim_scripts");
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    return remove_tree(tmpdir);
+}
+
+/* scripts/summary.sh counts every block and goes on past a file it cannot summarise. */
+static void test_summary_script(void **state)
+{
+    (void)state;
+    char two[512], bare[512], cmd[2048];
+    snprintf(two, sizeof two, "%s/two_blocks.h5", tmpdir);
+    snprintf(bare, sizeof bare, "%s/no_cof.h5", tmpdir);
+    snprintf(cmd, sizeof cmd,
+             "./bksim run configs/chains/two_block_coulomb.ini -q -o %s && "
+             "./bksim run configs/paper/case_a_coulomb.ini -q -o %s --set output.fields=x,v",
+             two, bare);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    bk_transition *rows = NULL;
+    size_t n = 0;
+    bk_error err = {0};
+    assert_int_equal(bk_h5_read_transitions(two, &rows, &n, &err), BK_OK);
+    long onsets[2] = {0, 0};
+    for (size_t k = 0; k < n; ++k)
+        onsets[rows[k].block] += rows[k].from == 0 && rows[k].to != 0;
+    free(rows);
+    assert_true(onsets[0] > 0 && onsets[1] > 0);
+    char *text = NULL;
+    snprintf(cmd, sizeof cmd, "BKSIM=./bksim scripts/summary.sh %s %s/missing.h5 %s", two, tmpdir, bare);
+    assert_int_equal(run_command(cmd, &text), 1);
+    char expected[64];
+    snprintf(expected, sizeof expected, "slip events %4ld", onsets[0] + onsets[1]);
+    assert_non_null(strstr(text, expected));
+    assert_non_null(strstr(text, "missing.h5: No such file"));
+    assert_non_null(strstr(text, "no_cof "));
+    assert_non_null(strstr(text, "apparent COF n/a"));
+    free(text);
+}
+
+/* The paper's plot scripts: any block, png/pdf/svg, and a clear refusal of bad options. */
+static void test_plot_scripts(void **state)
+{
+    (void)state;
+    char run[512], cmd[2048];
+    snprintf(run, sizeof run, "%s/plot_two.h5", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run configs/chains/two_block_coulomb.ini -q -o %s", run);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    const char *bin = bksim_binary();
+    static const char *const scripts[] = {"plot_cof.sh", "plot_kinematics.sh"};
+    for (size_t k = 0; k < 2; ++k) {
+        snprintf(cmd, sizeof cmd,
+                 "BKSIM=%s scripts/%s --format svg --block 1 %s/fig_%zu.svg 'two blocks' %s:block:black && "
+                 "grep -c '<svg' %s/fig_%zu.svg && grep -c 'block 1' %s/fig_%zu.svg",
+                 bin, scripts[k], tmpdir, k, run, tmpdir, k, tmpdir, k);
+        assert_int_equal(run_command(cmd, NULL), 0);
+        snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/%s --format pdf %s/fig_%zu.pdf t %s:b:black && "
+                 "head -c 5 %s/fig_%zu.pdf | grep -q '%%PDF'", bin, scripts[k], tmpdir, k, run, tmpdir, k);
+        assert_int_equal(run_command(cmd, NULL), 0);
+        snprintf(cmd, sizeof cmd, "scripts/%s --format gif %s/x t %s:b:black", scripts[k], tmpdir, run);
+        expect_command(cmd, 2, "--format must be png, pdf or svg");
+        snprintf(cmd, sizeof cmd, "scripts/%s --block -1 %s/x t %s:b:black", scripts[k], tmpdir, run);
+        expect_command(cmd, 2, "--block needs a block index");
+    }
+}
+
+/* The catalog's scripts on a 40-block chain whose ends fail 1 ms apart and slip at once
+ * (test_run_catalog.c's overlap scene): its first event holds two separate ruptures, which
+ * event_ruptures.sh counts; plot_mfd.sh draws both figures. */
+static void test_catalog_scripts(void **state)
+{
+    (void)state;
+    char path[512], out[512], cmd[2048];
+    char *text = NULL;
+    snprintf(path, sizeof path, "%s/ends.ini", tmpdir);
+    snprintf(out, sizeof out, "%s/ends.h5", tmpdir);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("[model]\nn_blocks = 40\ncoupling_stiffness = 100\n"
+          "[block]\nmass = 1\ndriver_stiffness = 1e4\n"
+          "[block.0]\nx_init = -2e-4\n[block.39]\nx_init = -1.99e-4\n"
+          "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
+          "[driver]\nvelocity = 1e-3\n[output]\ninterval = 0\n[run]\nt_end = 0.5\n",
+          f);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --quiet", path, out);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    const char *bin = bksim_binary();
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/event_ruptures.sh --table %s", bin, out);
+    assert_int_equal(run_command(cmd, &text), 0);
+    double t_start;
+    int n_blocks, ruptures;
+    assert_int_equal(sscanf(text, "%lf %d %d", &t_start, &n_blocks, &ruptures), 3);
+    assert_true(n_blocks >= 2 && ruptures == 2);
+    assert_non_null(strstr(text, "(100.0 %) hold two or more separate ruptures; 2 ruptures in all"));
+    free(text);
+    /* Without transitions there is nothing to count: an error, not a count of 0. */
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s/bare.h5 --set output.transitions=false --quiet "
+             "&& BKSIM=%s scripts/event_ruptures.sh %s/bare.h5", path, tmpdir, bin, tmpdir);
+    expect_command(cmd, 1, "transitions off");
+
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_mfd.sh -o %s/fig %s", bin, tmpdir, out);
+    assert_int_equal(run_command(cmd, &text), 0);
+    free(text);
+    snprintf(cmd, sizeof cmd, "%s/fig/ends_mfd.png", tmpdir);
+    assert_true(path_exists(cmd));
+    snprintf(cmd, sizeof cmd, "%s/fig/ends_spacetime.png", tmpdir);
+    assert_true(path_exists(cmd));
+
+    /* plot_slip_map.sh on a 4 x 5 lattice: the largest event, a chosen one, and one past the end. */
+    snprintf(path, sizeof path, "%s/sheet.ini", tmpdir);
+    f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("[model]\nrows = 4\ncols = 5\ncoupling_stiffness = 2e4\n"
+          "[block]\nmass = 1\ndriver_stiffness = 1e4\nx_init_random = 2e-5\n"
+          "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
+          "[driver]\nvelocity = 1e-3\n[output]\ninterval = 0\n[run]\nt_end = 0.5\n",
+          f);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s/sheet.h5 --quiet", path, tmpdir);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh -o %s/fig %s/sheet.h5", bin, tmpdir, tmpdir);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_non_null(strstr(text, "/fig/sheet_slip_map_"));
+    free(text);
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh --format svg --event 0 -o %s/fig %s/sheet.h5", bin,
+             tmpdir, tmpdir);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    /* Drawn as the 4 x 5 lattice it is, never as a strip of 20. */
+    snprintf(cmd, sizeof cmd, "grep -c -e '>row (block i / 5)<' -e '>column (block i %% 5)<' %s/fig/sheet_slip_map_0.svg",
+             tmpdir);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_string_equal(text, "2\n");
+    free(text);
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh --event 99999 -o %s/fig %s/sheet.h5", bin, tmpdir,
+             tmpdir);
+    expect_command(cmd, 1, "out of range");
+}
+
+/* The benchmark's smoke run: every back-end on case B at three tolerances, all succeed
+ * with the reference's stick-slip events and an error against the exact stepper that falls
+ * as rtol tightens; and the whole script (sweep, scaling, long run, plots, tables). */
+static void test_bench_smoke(void **state)
+{
+    (void)state;
+    char *text = NULL;
+    assert_int_equal(run_command("build/bench/bksim_bench --quick --repeats 1 --case B_coulomb", &text), 0);
+    char method[64] = "", last_method[64] = "";
+    double last_error = 0.0;
+    int rows = 0;
+    for (char *line = strtok(text, "\n"); line; line = strtok(NULL, "\n")) {
+        char name[64], status[16], events[16];
+        double rtol, cpu, error_x;
+        if (sscanf(line, "%63s %63s %lf %15s %lf %*f %*f %*d %*d %*d %*d %*d %15s %*d %lf", name, method, &rtol,
+                   status, &cpu, events, &error_x) != 7 ||
+            strcmp(name, "B_coulomb") != 0 || strncmp(method, "reference", 9) == 0)
+            continue;
+        ++rows;
+        assert_string_equal(status, "ok");
+        assert_string_equal(events, "same");
+        /* Within one method's sweep the error falls (exact has a single row). */
+        if (strcmp(method, last_method) == 0)
+            assert_true(error_x < last_error);
+        last_error = error_x;
+        snprintf(last_method, sizeof last_method, "%s", method);
+    }
+    free(text);
+    assert_true(rows >= 20);
+    if (run_command("command -v gnuplot", NULL) != 0)
+        return; /* the plots need gnuplot (quickstart.sh installs it) */
+    assert_int_equal(run_command("scripts/bench.sh --quick", &text), 0);
+    char dir[512] = "";
+    const char *at = strstr(text, "benchmark written to ");
+    assert_non_null(at);
+    assert_int_equal(sscanf(at, "benchmark written to %511[^\n]", dir), 1);
+    free(text);
+    const char *files[] = {"results.tsv", "scaling.tsv", "long_run.tsv", "tables.md", "wp_B_coulomb.png",
+                           "scaling.png"};
+    for (size_t k = 0; k < sizeof files / sizeof files[0]; ++k) {
+        char path[600];
+        snprintf(path, sizeof path, "%s/%s", dir, files[k]);
+        assert_true(path_exists(path));
+    }
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(run_command(cmd, NULL), 0);
+}
+
+/* The output benchmark's smoke run: its three tables, the writer's two scenes, rows that
+ * cost CVODE and the exact stepper no evaluation at all (they interpolate), and the exact
+ * stepper's rows on a 256-block cluster. */
+static void test_bench_output_smoke(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/bksim_bench_output_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "scripts/bench_output.sh --quick %s", dir);
+    char *text = NULL;
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_non_null(strstr(text, "| case B, 2 s, 0.1 ms rows | 1 |"));
+    assert_non_null(strstr(text, "| resting chain, every field | 100 |"));
+    assert_non_null(strstr(text, "| exact | 1.000 | 1.000 | 1.000 | - | - | - |"));
+    assert_non_null(strstr(text, "| cvode_adams | 1.000 | 1.000 | 1.000 | 1.000 | 1.000 | 1.000 |"));
+    assert_non_null(strstr(text, "| blocks in the cluster |"));
+    assert_non_null(strstr(text, "\n| 256 | "));
+    free(text);
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_summary_script),
+        cmocka_unit_test(test_plot_scripts),
+        cmocka_unit_test(test_catalog_scripts),
+        cmocka_unit_test(test_bench_smoke),
+        cmocka_unit_test(test_bench_output_smoke),
+    };
+    return cmocka_run_group_tests_name("scripts", tests, setup, teardown);
+}
