@@ -78,7 +78,7 @@ test-asan: build-asan/bksim build/bench/bksim_bench build/bench/h5_plain build/b
 # that time kills and wall clocks against the machine run alone after them.
 VALGRIND_FIRST := build/tests/test_run_catalog build/tests/test_backends
 test-valgrind: bksim $(TESTS)
-	@TEST_JOBS=2 TEST_ALONE="test_cli test_sweep test_extremes test_h5_writer" BK_TEST_TIME_SCALE=200 \
+	@TEST_JOBS=2 TEST_ALONE="test_cli_restart test_sweep test_extremes test_h5_writer" BK_TEST_TIME_SCALE=200 \
 	 VALGRIND="valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible --show-leak-kinds=definite,indirect,possible" \
 	 scripts/run_tests.sh valgrind $(filter $(VALGRIND_FIRST),$(TESTS)) $(filter-out $(VALGRIND_FIRST),$(TESTS))
 

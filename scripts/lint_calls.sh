@@ -1,17 +1,20 @@
 #!/usr/bin/env bash
-# Fail when the given object files call one another in a circle.
-#
-# usage: lint_calls.sh OBJECT.o...
-#
-# File A calls file B when A leaves undefined a symbol that B defines (nm).  The files must
-# stand in layers, each calling only files below it (README "Layout and development"): a
-# satellite reaches its top file only through function pointers it is handed.  tsort finds
-# the circles; each is printed with the names that tie its files.  Calls through pointers
-# and static inline functions are not seen, as they tie no object to another.
+# Fail when the given object files call one another in a circle (make lint runs it on the
+# library's objects).  File A calls file B when A leaves undefined a symbol that B defines
+# (nm).  The files must stand in layers, each calling only files below it (README "Layout
+# and development"): a satellite reaches its top file only through function pointers it is
+# handed.  tsort finds the circles; each is printed with the names that tie its files.
+# Calls through pointers and static inline functions tie no object to another and are not
+# seen.
+# usage: scripts/lint_calls.sh OBJECT.o...
 set -euo pipefail
-[ $# -gt 0 ] || { echo "usage: $0 OBJECT.o..." >&2; exit 2; }
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+case "${1:-}" in -h | --help) bk_help ;; esac
+[ $# -gt 0 ] || bk_usage
+for object in "$@"; do bk_need_file "$object" object 2; done
+bk_need_command nm binutils
+bk_need_command tsort coreutils
+bk_temp_dir work
 for object in "$@"; do
     nm --defined-only "$object" | awk -v f="$object" 'NF == 3 && $2 ~ /[TDRB]/ {print $3, f}'
 done | sort > "$work/defined"

@@ -28,4 +28,4 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 make -j"$(nproc)" bksim
-make "$target"
+make -j"$(nproc)" "$target"
