@@ -19,7 +19,6 @@
  * costs time in proportion to the islands it touches and log N for the queues. */
 #include "bksim/run.h"
 
-#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -11,7 +11,6 @@
  * times never see each other: the scheduler (run.c) always handles the earliest pending
  * event first, and every island's last step then contains that time, so its state there is
  * at hand (dense output) when a merge needs it. */
-#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
