@@ -231,7 +231,6 @@ static int reserve_vectors(run_ctx *ctx, run_island *isl, size_t len)
     return BK_OK;
 }
 
-/* (Re)start island id at t on its blocks' current state. */
 int bk_run_start_island(run_ctx *ctx, size_t id, double t)
 {
     run_island *isl = ctx->islands[id];
@@ -275,9 +274,6 @@ int bk_run_start_island(run_ctx *ctx, size_t id, double t)
     return BK_OK;
 }
 
-/* The island's state at t into the chain's arrays: its own vector where it stands at t,
- * else dense output (t lies in its last step: see the scheduler in run.c); for an output
- * row (for_row), the back-end's output-row interpolant where it has one. */
 int bk_run_unpack_island(run_ctx *ctx, run_island *isl, double t, int for_row, bk_energy *increments)
 {
     const double *y = isl->y;

@@ -8,11 +8,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "bksim/bksim.h"
 #include "output/h5_impl.h"
-#include "paths.h"
 
 /* A checkpoint has to survive a crash while the next one is written.  HDF5 writes raw data
  * when asked but keeps attributes in its metadata cache until a flush, so a checkpoint

@@ -162,6 +162,7 @@ int bk_stats_report_read(const char *path, const bk_stats_options *opt, bk_stats
                          bk_error *err)
 {
     *out = NULL;
+    /* A bad option is refused before the file is opened, whatever is wrong with the file. */
     if (opt) {
         int rc = bk_stats_options_check(opt, err);
         if (rc != BK_OK)
