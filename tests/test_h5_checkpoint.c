@@ -226,10 +226,7 @@ static void test_restartable(void **state)
     assert_true(t == -1.0);
 
     /* Garbage under the .part name. */
-    FILE *g = fopen(part_path(f->path), "w");
-    assert_non_null(g);
-    fputs("not HDF5\n", g);
-    fclose(g);
+    assert_int_equal(write_text(part_path(f->path), "not HDF5\n"), 0);
     assert_int_equal(bk_h5_restartable(f->path, &t, &err), 0);
 
     run_into(config, f->path, 2, 10);

@@ -268,9 +268,7 @@ static void test_errors(void **state)
 
     /* Not HDF5. */
     snprintf(path, sizeof path, "%s/text.h5", dir);
-    FILE *f = fopen(path, "w");
-    fputs("t_start magnitude\n", f);
-    fclose(f);
+    assert_int_equal(write_text(path, "t_start magnitude\n"), 0);
     assert_int_not_equal(bk_h5_read_event_table(path, &table, &err), BK_OK);
     assert_non_null(strstr(err.message, "not an HDF5 file"));
 

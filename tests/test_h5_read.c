@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "bksim/bksim.h"
+#include "files.h"
 #include "output_fixture.h"
 #include "output_files.h"
 
@@ -18,10 +19,7 @@ static void test_missing_and_garbage_files(void **state)
     snprintf(missing, sizeof missing, "%s/missing.h5", f->dir);
     snprintf(garbage, sizeof garbage, "%s/garbage.h5", f->dir);
     snprintf(truncated, sizeof truncated, "%s/truncated.h5", f->dir);
-    FILE *g = fopen(garbage, "w");
-    assert_non_null(g);
-    fputs("this is not HDF5\n", g);
-    fclose(g);
+    assert_int_equal(write_text(garbage, "this is not HDF5\n"), 0);
     /* A real output cut short: signature present, the rest missing. */
     write_small(f->path, 0);
     FILE *in = fopen(f->path, "rb");

@@ -556,9 +556,7 @@ static void test_rename_failure(void **state)
     assert_int_equal(mkdir(f->path, 0700), 0);
     char inside[256];
     snprintf(inside, sizeof inside, "%s/keep", f->path);
-    FILE *k = fopen(inside, "w");
-    assert_non_null(k);
-    fclose(k);
+    assert_int_equal(write_text(inside, ""), 0);
     assert_int_equal(bk_h5_writer_finish(w, NULL, &err), BK_ERR_IO);
     assert_non_null(strstr(err.message, "cannot rename to"));
     hid_t file = H5Fopen(part_path(f->path), H5F_ACC_RDONLY, H5P_DEFAULT);
@@ -589,9 +587,7 @@ static void test_open_fails_cleanly(void **state)
     bk_config *c = synthetic_config(2, BK_FIELD_X, 0, 0);
     char blocker[256], path[300];
     snprintf(blocker, sizeof blocker, "%s/blocker", f->dir);
-    FILE *b = fopen(blocker, "w");
-    assert_non_null(b);
-    fclose(b);
+    assert_int_equal(write_text(blocker, ""), 0);
     snprintf(path, sizeof path, "%s/sub/run.h5", blocker);
     char not_null;
     bk_h5_writer *w = (bk_h5_writer *)(void *)&not_null; /* open must reset it to NULL */

@@ -47,9 +47,7 @@ static void test_parent_directories(void **state)
     assert_int_equal(bk_output_make_parent_dirs("run.h5", &err), BK_OK);
 
     snprintf(blocker, sizeof blocker, "%s/file", f->dir);
-    FILE *b = fopen(blocker, "w");
-    assert_non_null(b);
-    fclose(b);
+    assert_int_equal(write_text(blocker, ""), 0);
     snprintf(path, sizeof path, "%s/file/sub/run.h5", f->dir);
     assert_int_equal(bk_output_make_parent_dirs(path, &err), BK_ERR_IO);
     assert_non_null(strstr(err.message, path));
@@ -61,10 +59,7 @@ static void test_durable_rename(void **state)
 {
     output_fixture *f = *state;
     bk_error err = {0};
-    FILE *p = fopen(part_path(f->path), "w");
-    assert_non_null(p);
-    fputs("finished\n", p);
-    fclose(p);
+    assert_int_equal(write_text(part_path(f->path), "finished\n"), 0);
     assert_int_equal(bk_output_durable_rename(part_path(f->path), f->path, &err), BK_OK);
     assert_false(path_exists(part_path(f->path)));
     assert_true(path_exists(f->path));
@@ -79,9 +74,7 @@ static void test_durable_rename(void **state)
     snprintf(target, sizeof target, "%s/taken", f->dir);
     snprintf(inside, sizeof inside, "%s/keep", target);
     assert_int_equal(mkdir(target, 0700), 0);
-    FILE *k = fopen(inside, "w");
-    assert_non_null(k);
-    fclose(k);
+    assert_int_equal(write_text(inside, ""), 0);
     assert_int_equal(bk_output_durable_rename(f->path, target, &err), BK_ERR_IO);
     assert_non_null(strstr(err.message, "cannot rename to"));
     assert_true(path_exists(f->path));

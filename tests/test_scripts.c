@@ -95,15 +95,12 @@ static void test_catalog_scripts(void **state)
     char *text = NULL;
     snprintf(path, sizeof path, "%s/ends.ini", tmpdir);
     snprintf(out, sizeof out, "%s/ends.h5", tmpdir);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs("[model]\nn_blocks = 40\ncoupling_stiffness = 100\n"
-          "[block]\nmass = 1\ndriver_stiffness = 1e4\n"
-          "[block.0]\nx_init = -2e-4\n[block.39]\nx_init = -1.99e-4\n"
-          "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
-          "[driver]\nvelocity = 1e-3\n[output]\ninterval = 0\n[run]\nt_end = 0.5\n",
-          f);
-    fclose(f);
+    const char *ends = "[model]\nn_blocks = 40\ncoupling_stiffness = 100\n"
+                       "[block]\nmass = 1\ndriver_stiffness = 1e4\n"
+                       "[block.0]\nx_init = -2e-4\n[block.39]\nx_init = -1.99e-4\n"
+                       "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
+                       "[driver]\nvelocity = 1e-3\n[output]\ninterval = 0\n[run]\nt_end = 0.5\n";
+    assert_int_equal(write_text(path, ends), 0);
     snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --quiet", path, out);
     assert_int_equal(run_command(cmd, NULL), 0);
     const char *bin = bksim_binary();
@@ -130,14 +127,11 @@ static void test_catalog_scripts(void **state)
 
     /* plot_slip_map.sh on a 4 x 5 lattice: the largest event, a chosen one, and one past the end. */
     snprintf(path, sizeof path, "%s/sheet.ini", tmpdir);
-    f = fopen(path, "w");
-    assert_non_null(f);
-    fputs("[model]\nrows = 4\ncols = 5\ncoupling_stiffness = 2e4\n"
-          "[block]\nmass = 1\ndriver_stiffness = 1e4\nx_init_random = 2e-5\n"
-          "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
-          "[driver]\nvelocity = 1e-3\n[output]\ninterval = 0\n[run]\nt_end = 0.5\n",
-          f);
-    fclose(f);
+    const char *sheet = "[model]\nrows = 4\ncols = 5\ncoupling_stiffness = 2e4\n"
+                        "[block]\nmass = 1\ndriver_stiffness = 1e4\nx_init_random = 2e-5\n"
+                        "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
+                        "[driver]\nvelocity = 1e-3\n[output]\ninterval = 0\n[run]\nt_end = 0.5\n";
+    assert_int_equal(write_text(path, sheet), 0);
     snprintf(cmd, sizeof cmd, "./bksim run %s -o %s/sheet.h5 --quiet", path, tmpdir);
     assert_int_equal(run_command(cmd, NULL), 0);
     snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh -o %s/fig %s/sheet.h5", bin, tmpdir, tmpdir);

@@ -9,6 +9,15 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+int write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    int failed = fputs(text, f) == EOF && *text != '\0';
+    return fclose(f) != 0 || failed ? -1 : 0;
+}
+
 int path_exists(const char *path)
 {
     struct stat st;

@@ -12,6 +12,8 @@ int path_exists(const char *path);
 char *part_path(const char *path);
 /* A fresh directory /tmp/<prefix>_XXXXXX, its name in dir; returns 0, or -1. */
 int make_temp_dir(char *dir, size_t size, const char *prefix);
+/* A file holding exactly text (replaced if it exists; "" makes it empty); returns 0, or -1. */
+int write_text(const char *path, const char *text);
 /* cp src dst (dst replaced); returns 0, or -1. */
 int copy_file(const char *src, const char *dst);
 /* rm -rf path: returns 0 when nothing of it is left (or there was none), else -1. */
