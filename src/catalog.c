@@ -8,6 +8,7 @@
 #include "bksim/catalog.h"
 #include "bksim/modes.h"
 #include "capacity.h"
+#include "extent.h"
 
 struct bk_catalog {
     size_t n;
@@ -117,76 +118,14 @@ static void episode_end(bk_catalog *c, size_t i, double x, double force)
     c->last_force[i] = force;
 }
 
-static int compare_blocks(const void *a, const void *b)
-{
-    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
-    return (x > y) - (x < y);
-}
-
-/* The first and last of k distinct sorted lines along a direction of len lines: on a ring
- * the shorter arc covering them, the complement of the widest gap between two of them. */
-static void span(const int32_t *line, size_t k, size_t len, int ring, int32_t *first, int32_t *last)
-{
-    *first = line[0];
-    *last = line[k - 1];
-    if (!ring || k == 1)
-        return;
-    /* The gap after the last line wraps round to the first. */
-    int64_t widest = (int64_t)len - line[k - 1] + line[0];
-    for (size_t j = 1; j < k; ++j) {
-        int64_t gap = (int64_t)line[j] - line[j - 1];
-        if (gap > widest) {
-            widest = gap;
-            *first = line[j];
-            *last = line[j - 1];
-        }
-    }
-}
-
-/* Sort and drop repeats; returns the count left. */
-static size_t distinct(int32_t *values, size_t k)
-{
-    qsort(values, k, sizeof *values, compare_blocks);
-    size_t kept = 0;
-    for (size_t j = 0; j < k; ++j)
-        if (kept == 0 || values[j] != values[kept - 1])
-            values[kept++] = values[j];
-    return kept;
-}
-
-/* The extent: on a chain the first and last block (on a ring the shorter arc); on a lattice
- * the bounding box, left its top-left corner and right its bottom-right one (each
- * direction's span as a chain's).  Returns -1 when out of memory. */
-static int extent(bk_catalog *c, bk_event *e)
-{
-    size_t k = c->n_involved;
-    qsort(c->involved, k, sizeof *c->involved, compare_blocks);
-    if (c->rows == 1) {
-        span(c->involved, k, c->n, c->ring_cols, &e->left, &e->right);
-        return 0;
-    }
-    int32_t *lines = bk_grow_array(c->lines, &c->lines_capacity, k, sizeof *lines, 64);
-    if (!lines)
-        return -1;
-    c->lines = lines;
-    int32_t cols = (int32_t)c->cols, row_first, row_last, col_first, col_last;
-    for (size_t j = 0; j < k; ++j)
-        lines[j] = c->involved[j] / cols;
-    span(lines, distinct(lines, k), c->rows, c->ring_rows, &row_first, &row_last);
-    for (size_t j = 0; j < k; ++j)
-        lines[j] = c->involved[j] % cols;
-    span(lines, distinct(lines, k), c->cols, c->ring_cols, &col_first, &col_last);
-    e->left = row_first * cols + col_first;
-    e->right = row_last * cols + col_last;
-    return 0;
-}
-
 static int close_event(bk_catalog *c, double t_end, bk_event *out)
 {
     bk_event *e = &c->event;
     e->t_end = t_end;
     e->n_blocks = (int32_t)c->n_involved;
-    if (extent(c, e) != 0) /* sorts the blocks: the sum below goes in block order, as after a restore */
+    /* Sorts the blocks: the sum below goes in block order, as after a restore. */
+    if (bk_extent(c->rows, c->cols, c->ring_rows, c->ring_cols, c->involved, c->n_involved, &c->lines,
+                  &c->lines_capacity, &e->left, &e->right) != 0)
         return BK_ERR_NOMEM;
     double drop = 0.0;
     for (size_t j = 0; j < c->n_involved; ++j)

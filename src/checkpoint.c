@@ -49,6 +49,7 @@ const bk_checkpoint_field bk_checkpoint_fields[] = {
     CATALOG_SCALAR(potency, F64),
     CATALOG_SCALAR(max_slip_rate, F64),
     CATALOG_SCALAR(events, LONG),
+    {"catalog_rupture_state", 1, BK_CHECKPOINT_F64, BK_CHECKPOINT_VARIABLE, offsetof(bk_catalog_state, rupture_state), 0},
 };
 const size_t bk_checkpoint_n_fields = sizeof bk_checkpoint_fields / sizeof bk_checkpoint_fields[0];
 
@@ -90,6 +91,8 @@ size_t bk_checkpoint_type_size(bk_checkpoint_type type)
     return sizeof(long);
 }
 
+static char *field_base(const bk_checkpoint_field *field, const bk_checkpoint *cp);
+
 size_t bk_checkpoint_field_count(const bk_checkpoint_field *field, const bk_checkpoint *cp)
 {
     if (!bk_checkpoint_field_present(field, cp))
@@ -99,6 +102,11 @@ size_t bk_checkpoint_field_count(const bk_checkpoint_field *field, const bk_chec
         return cp->n_blocks;
     case BK_CHECKPOINT_PER_STATE:
         return cp->n_state;
+    case BK_CHECKPOINT_VARIABLE: {
+        long count;
+        memcpy(&count, field_base(field, cp) + field->offset + sizeof(double *), sizeof count);
+        return count > 0 ? (size_t)count : 0;
+    }
     case BK_CHECKPOINT_SCALAR:
         break;
     }
@@ -127,6 +135,8 @@ int bk_checkpoint_field_stored(const bk_checkpoint_field *field, const bk_checkp
 {
     if (!bk_checkpoint_field_present(field, cp))
         return 0;
+    if (field->extent == BK_CHECKPOINT_VARIABLE)
+        return bk_checkpoint_field_count(field, cp) > 0;
     if (!field->if_nonzero)
         return 1;
     double value;
@@ -162,7 +172,7 @@ static int alloc_arrays(bk_checkpoint *cp, int catalog)
 {
     for (size_t k = 0; k < bk_checkpoint_n_fields; ++k) {
         const bk_checkpoint_field *f = &bk_checkpoint_fields[k];
-        if (f->extent == BK_CHECKPOINT_SCALAR || f->catalog != catalog)
+        if (f->extent == BK_CHECKPOINT_SCALAR || f->extent == BK_CHECKPOINT_VARIABLE || f->catalog != catalog)
             continue;
         size_t count = bk_checkpoint_field_count(f, cp);
         /* At least one element, so a chain without friction states still gets a pointer. */

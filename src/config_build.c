@@ -529,6 +529,7 @@ static void build_catalog(loader *ld, bk_config *c)
     o->events = (int)value_of(ld, "output", "events");
     c->catalog.magnitude_offset = value_of(ld, "catalog", "magnitude_offset");
     c->catalog.slip_rate_threshold = value_of(ld, "catalog", "slip_rate_threshold");
+    c->catalog.rupture_rate = (int)value_of(ld, "catalog", "rupture_rate");
     entry *events = bk_config_lookup(ld, "output", "events");
     entry *threshold = bk_config_lookup(ld, "catalog", "slip_rate_threshold");
     if (c->prescribed) {

@@ -175,6 +175,11 @@ static const key_def keys[] = {
                  "for laws without a stuck state (dieterich_ruina_*): a block slips, for the catalog, while its "
                  "|slip rate| exceeds this; required for such laws when events are on"},
      BK_KEY_NUMBER, NULL, NULL, "none"},
+    {"catalog", {"rupture_rate", "", 1, 0, 1, 0,
+                 "write /rupture_rate, every rupture's moment-rate function (the sum of |v| over its slipping "
+                 "blocks) sampled finely enough that it integrates to the rupture's potency to 1e-3; false keeps "
+                 "/ruptures and /rupture_blocks only"},
+     BK_KEY_BOOLEAN, NULL, NULL, "true"},
 
     NUM("run", "t_end", "s", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE,
         "end time (runs from 0); with a prescribed schedule or [driver] velocities optional, at most the "
@@ -298,7 +303,9 @@ void bk_config_write_reference(FILE *out)
         "driver", "The driver that pulls every block through its driver spring.",
         "solver", "Integration.",
         "output", "The HDF5 file.",
-        "catalog", "The event catalog (/events): an event is a maximal interval during which some block slips.",
+        "catalog", "The rupture catalog (/ruptures, /rupture_blocks, /rupture_rate: connected sets of slip episodes, "
+                   "README \"Ruptures\") and the time-window catalog (/events: maximal intervals during which some "
+                   "block slips).",
         "run", "The time span.",
         "prescribed", "A prescribed-motion scene instead of the chain's dynamics (paper Figure 2, slide-hold-slide): "
                       "one block slides at a piecewise-constant slip rate and its friction state follows the law's "

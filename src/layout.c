@@ -82,7 +82,7 @@ double bk_output_row_bytes(unsigned fields, size_t n_blocks, size_t n_state, int
     return bytes;
 }
 
-void bk_output_dataset_names(unsigned fields, size_t n_state, int damped, int transitions, int events,
+void bk_output_dataset_names(unsigned fields, size_t n_state, int damped, int transitions, unsigned catalogs,
                              char *buf, size_t len)
 {
     size_t used = 0;
@@ -98,6 +98,11 @@ void bk_output_dataset_names(unsigned fields, size_t n_state, int damped, int tr
         if (n > 0 && (size_t)n < len - used)
             used += (size_t)n;
     }
-    if (events)
-        snprintf(buf + used, len - used, "%sevents", used ? "," : "");
+    static const char *const catalog_names[] = {"events", "ruptures,rupture_blocks", "rupture_rate"};
+    for (int k = 0; k < 3; ++k)
+        if (catalogs & (1 << k)) {
+            int n = snprintf(buf + used, len - used, "%s%s", used ? "," : "", catalog_names[k]);
+            if (n > 0 && (size_t)n < len - used)
+                used += (size_t)n;
+        }
 }

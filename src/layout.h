@@ -58,6 +58,36 @@ extern const char *const bk_output_field_names[];
     "magnitude_offset; stress_drop: mean drop of the applied force over the blocks; "          \
     "complete: 0 for an event still running at the end of the run"
 
+/* Bytes of one record of /ruptures (packed: t_start, t_end, first_block, n_blocks, left,
+ * right, n_episodes, potency, magnitude, max_slip_rate, stress_drop, duration,
+ * front_speed_left, front_speed_right, complete), of /rupture_blocks (rupture, block,
+ * t_onset, t_stop, slip) and of /rupture_rate (rupture, t, rate). */
+#define BK_RUPTURE_RECORD_BYTES 93
+#define BK_RUPTURE_BLOCK_RECORD_BYTES 36
+#define BK_RUPTURE_RATE_RECORD_BYTES 24
+
+#define BK_RUPTURES_UNITS                                                                    \
+    "t_start: s, t_end: s, first_block: 1, n_blocks: 1, left: 1, right: 1, n_episodes: 1, " \
+    "potency: m, magnitude: 1, max_slip_rate: m/s, stress_drop: N, duration: s, "          \
+    "front_speed_left: 1/s, front_speed_right: 1/s, complete: 1"
+#define BK_RUPTURES_DESCRIPTION                                                                    \
+    "ruptures: connected sets of slip episodes, two episodes linked when their blocks are the "   \
+    "same or neighbours and their closed time intervals meet (README \"Ruptures\"), in the order " \
+    "they complete (by t_end, then t_start, then first_block). first_block: the epicentre; "     \
+    "left..right: the extent as in /events; potency: sum of |slip| over the episodes; "         \
+    "front_speed_left/right: blocks per second from a least-squares fit of arrival time "       \
+    "against distance from the epicentre on each side (NaN with fewer than 3 points, inf when " \
+    "simultaneous); complete: 0 for a rupture still running at the end of the run"
+#define BK_RUPTURE_BLOCKS_UNITS "rupture: 1, block: 1, t_onset: s, t_stop: s, slip: m"
+#define BK_RUPTURE_BLOCKS_DESCRIPTION                                                         \
+    "the blocks of each rupture (rupture: row of /ruptures), in block order: t_onset its first " \
+    "onset in the rupture (the front's arrival), t_stop its last stop, slip its net displacement"
+#define BK_RUPTURE_RATE_UNITS "rupture: 1, t: s, rate: m/s"
+#define BK_RUPTURE_RATE_DESCRIPTION                                                            \
+    "moment-rate (potency-rate) function of each rupture (rupture: row of /ruptures): the sum "  \
+    "of |v| over its slipping blocks, sampled from the integrator's dense output finely enough " \
+    "that its trapezoid integral is the rupture's potency to 1e-3"
+
 /* Whether a run with these output fields and friction states, and dashpots or not (damped),
  * writes this series: the one rule behind the layout, the list of datasets a reader must find
  * and the size estimate. */
@@ -74,8 +104,12 @@ double bk_output_row_bytes(unsigned fields, size_t n_blocks, size_t n_state, int
 
 /* The datasets a run of this layout writes, comma-separated (recorded in the root attribute
  * "datasets" so that a check needs no config to know what must be there). */
-#define BK_DATASET_LIST_LEN 256
-void bk_output_dataset_names(unsigned fields, size_t n_state, int damped, int transitions, int events,
+#define BK_DATASET_LIST_LEN 320
+/* The catalog tables written (catalogs: a mask of these). */
+#define BK_CATALOG_EVENTS 1u       /* /events */
+#define BK_CATALOG_RUPTURES 2u     /* /ruptures and /rupture_blocks */
+#define BK_CATALOG_RUPTURE_RATE 4u /* /rupture_rate */
+void bk_output_dataset_names(unsigned fields, size_t n_state, int damped, int transitions, unsigned catalogs,
                              char *buf, size_t len);
 
 #endif

@@ -211,6 +211,7 @@ static void resolve_scales(run_ctx *ctx)
 
 static void free_ctx(run_ctx *ctx)
 {
+    bk_run_ruptures_free(ctx);
     bk_run_catalog_free(ctx);
     bk_run_islands_free(ctx);
     bk_run_partition_free(ctx);
@@ -340,7 +341,7 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
     }
     /* Scales come from the initial state in a resumed run too, so both runs use the same. */
     resolve_scales(&ctx);
-    if ((rc = bk_run_catalog_init(&ctx, from)) != BK_OK)
+    if ((rc = bk_run_catalog_init(&ctx, from)) != BK_OK || (rc = bk_run_ruptures_init(&ctx, from)) != BK_OK)
         goto done;
 
     if (from) {
@@ -365,6 +366,8 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
         rc = close_instant(&ctx);
     if (rc == BK_OK)
         rc = bk_run_catalog_finish(&ctx, ctx.t_end);
+    if (rc == BK_OK)
+        rc = bk_run_ruptures_finish(&ctx, ctx.t_end);
 
 done:
     bk_run_collect_stats(&ctx, ctx.stats, (double)cpu0);

@@ -137,25 +137,18 @@ int bk_run_catalog_finish(run_ctx *ctx, double t)
     return rc == 1 ? emit(ctx, &event) : BK_OK;
 }
 
-bk_catalog_state *bk_run_catalog_save(run_ctx *ctx)
+int bk_run_catalog_save(run_ctx *ctx, bk_catalog_state **state)
 {
+    *state = NULL;
     if (!ctx->catalog)
-        return NULL;
+        return BK_OK;
     bk_catalog_save(ctx->catalog, &ctx->catalog_state);
     ctx->catalog_state.events = ctx->events;
-    return &ctx->catalog_state;
+    *state = &ctx->catalog_state;
+    return bk_run_ruptures_save(ctx, &ctx->catalog_state);
 }
 
 /* ------------------------------------------------------------ largest slip rate --- */
-
-/* d|v|/dt of slipping block i for the island's vector y at t (from rest: along its mode). */
-static double speed_rate(const run_island *isl, size_t i, double t, const double *y)
-{
-    const bk_scene *scene = isl->island.scene;
-    double v = y[scene->slot[i] + 1], dir = (double)scene->mode[i];
-    double accel = dir * bk_island_slip_acceleration(&isl->island, i, t, y);
-    return v > 0.0 ? accel : v < 0.0 ? -accel : dir * accel;
-}
 
 void bk_run_catalog_island_start(run_ctx *ctx, const run_island *isl)
 {
@@ -167,38 +160,10 @@ void bk_run_catalog_island_start(run_ctx *ctx, const run_island *isl)
     for (size_t k = 0; k < island->n_active; ++k) {
         size_t i = island->active[k];
         ctx->rate_v[i] = isl->y[scene->slot[i] + 1];
-        ctx->rate_a[i] = speed_rate(isl, i, island->t_ref, isl->y);
+        ctx->rate_a[i] = bk_run_speed_rate(isl, i, island->t_ref, isl->y);
         fastest = fmax(fastest, fabs(ctx->rate_v[i]));
     }
     bk_catalog_slip_rate(ctx->catalog, fastest);
-}
-
-/* The largest value of the cubic with values u0, u1 and slopes d0 > 0 > d1 at 0 and h. */
-static double hermite_peak(double u0, double d0, double u1, double d1, double h)
-{
-    /* p(s) = u0 + d0 h s + c2 s^2 + c3 s^3 on s in [0, 1]. */
-    double c2 = 3.0 * (u1 - u0) - (2.0 * d0 + d1) * h;
-    double c3 = 2.0 * (u0 - u1) + (d0 + d1) * h;
-    double a = 3.0 * c3, b = 2.0 * c2, c = d0 * h; /* p'(s) = a s^2 + b s + c */
-    double s;
-    if (fabs(a) < 1e-14 * (fabs(b) + fabs(c)))
-        s = -c / b;
-    else {
-        double disc = sqrt(fmax(b * b - 4.0 * a * c, 0.0));
-        /* p' > 0 at 0 and < 0 at 1: its one zero in between. */
-        double q = -0.5 * (b + copysign(disc, b));
-        double s1 = q / a, s2 = c / q;
-        s = s1 > 0.0 && s1 < 1.0 ? s1 : s2;
-    }
-    s = fmin(fmax(s, 0.0), 1.0);
-    return u0 + s * (d0 * h + s * (c2 + s * c3));
-}
-
-static double peak_function(double t, void *user)
-{
-    bk_block_probe *p = user;
-    const double *y = bk_run_probe_state(p, t);
-    return y ? speed_rate(p->isl, p->block, t, y) : 0.0;
 }
 
 int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl)
@@ -225,10 +190,10 @@ int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl)
     size_t best = SIZE_MAX;
     for (size_t k = 0; k < island->n_active; ++k) {
         size_t i = island->active[k];
-        double v = y[scene->slot[i] + 1], rate = speed_rate(isl, i, hi, y);
+        double v = y[scene->slot[i] + 1], rate = bk_run_speed_rate(isl, i, hi, y);
         fastest = fmax(fastest, fabs(v));
         if (ctx->rate_a[i] > 0.0 && rate < 0.0 && hi > lo) {
-            double estimate = hermite_peak(fabs(ctx->rate_v[i]), ctx->rate_a[i], fabs(v), rate, hi - lo);
+            double estimate = bk_run_hermite_peak(fabs(ctx->rate_v[i]), ctx->rate_a[i], fabs(v), rate, hi - lo);
             if (estimate > best_estimate) {
                 best_estimate = estimate;
                 best = i;
@@ -241,8 +206,8 @@ int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl)
     if (best == SIZE_MAX || best_estimate <= bk_catalog_max_slip_rate(ctx->catalog))
         return BK_OK;
     bk_block_probe probe = {ctx, isl, best, BK_OK};
-    gsl_function fn = {peak_function, &probe};
-    double f_lo = peak_function(lo, &probe), f_hi = peak_function(hi, &probe);
+    gsl_function fn = {bk_run_speed_rate_probe, &probe};
+    double f_lo = bk_run_speed_rate_probe(lo, &probe), f_hi = bk_run_speed_rate_probe(hi, &probe);
     double t_peak = hi;
     if (probe.status == BK_OK && f_lo > 0.0 && f_hi < 0.0)
         t_peak = bk_run_zero_after(ctx, &fn, lo, hi);

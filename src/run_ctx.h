@@ -11,6 +11,7 @@
 #include "bksim/catalog.h"
 #include "bksim/checkpoint.h"
 #include "bksim/config.h"
+#include "bksim/rupture.h"
 #include "bksim/sink.h"
 #include "bksim/solver.h"
 #include "heap.h"
@@ -142,6 +143,15 @@ typedef struct run_ctx {
     double t_catalog;     /* s, where the builder's force callback evaluates */
     double *rate_v, *rate_a; /* per block: v and d|v|/dt at its island's last step end */
     bk_catalog_state catalog_state; /* what a checkpoint saves (arrays only with checkpoints) */
+
+    /* The rupture catalog (run_ruptures.c); NULL when the run keeps none. */
+    bk_ruptures *ruptures;
+    double *rupture_v, *rupture_a; /* per block: v and d|v|/dt at its island's last step end */
+    double t_rupture_force;  /* s, where the builder's force callback evaluates */
+    double *rupture_saved;   /* the builder's state for a checkpoint */
+    size_t rupture_saved_capacity;
+    void *rupture_steps;     /* scratch: a step's slipping blocks */
+    size_t rupture_steps_capacity;
 } run_ctx;
 
 /* qsort's order of block indices (size_t). */
@@ -153,8 +163,8 @@ static inline int bk_compare_blocks(const void *a, const void *b)
 
 /* The run loop's files call one another downward only, in the order they are listed below:
  * run.c (set-up and the scheduler) on top, then restarts, island events, the partition, the
- * islands, quiet blocks, rows, transitions, the catalog, the energy books, probes and the
- * clock.  A file calls only files listed after it, never one before: no circle of calls
+ * islands, quiet blocks, rows, transitions, the event catalog, the rupture catalog, the
+ * energy books, probes and the clock.  A file calls only files listed after it, never one before: no circle of calls
  * (make lint checks it on the objects, scripts/lint_calls.sh). */
 
 /* ---- run_restart.c ---- */
@@ -242,11 +252,27 @@ void bk_run_catalog_free(run_ctx *ctx);
 int bk_run_catalog_transition(run_ctx *ctx, const bk_transition *transition);
 /* The end of the run at t (the chain's arrays unpacked there): the last event. */
 int bk_run_catalog_finish(run_ctx *ctx, double t);
-/* The builder's state for a checkpoint; NULL without a catalog. */
-bk_catalog_state *bk_run_catalog_save(run_ctx *ctx);
+/* The builders' state for a checkpoint (*state NULL without a catalog); BK_ERR_NOMEM when the
+ * rupture catalog's cannot be copied. */
+int bk_run_catalog_save(run_ctx *ctx, bk_catalog_state **state);
 /* Slip rates of an island just (re)started, and of its last step (maxima inside it too). */
 void bk_run_catalog_island_start(run_ctx *ctx, const run_island *isl);
 int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl);
+
+/* ---- run_ruptures.c ---- */
+/* The builder, begun at t = 0 from the chain's arrays or restored from a checkpoint (none
+ * without the event catalog, or from a checkpoint written before ruptures). */
+int bk_run_ruptures_init(run_ctx *ctx, const bk_checkpoint *from);
+void bk_run_ruptures_free(run_ctx *ctx);
+/* A transition, as it happens; completed ruptures go to the sink. */
+int bk_run_ruptures_transition(run_ctx *ctx, const bk_transition *transition);
+/* The end of the run at t (the chain's arrays unpacked there): the ruptures left. */
+int bk_run_ruptures_finish(run_ctx *ctx, double t);
+/* The builder's state into a checkpoint's catalog part (nothing without ruptures). */
+int bk_run_ruptures_save(run_ctx *ctx, bk_catalog_state *state);
+/* Speed samples of an island just (re)started, and of its last step. */
+void bk_run_ruptures_island_start(run_ctx *ctx, const run_island *isl);
+int bk_run_ruptures_island_step(run_ctx *ctx, run_island *isl);
 
 /* ---- run_books.c ---- */
 /* Block i changes between stuck and slipping at t (the chain's arrays unpacked): the
@@ -274,6 +300,13 @@ typedef struct bk_block_probe {
 } bk_block_probe;
 /* The island's vector at t (in isl->y_probe); NULL, with status set, when the back-end fails. */
 const double *bk_run_probe_state(bk_block_probe *probe, double t);
+/* d|v|/dt of slipping block i for the island's vector y at t (from rest: along its mode). */
+double bk_run_speed_rate(const run_island *isl, size_t i, double t, const double *y);
+/* The same on the island's last-step interpolant (a bk_block_probe), for Brent. */
+double bk_run_speed_rate_probe(double t, void *probe);
+/* The largest value of the cubic Hermite interpolant with values u0, u1 and slopes d0 > 0 >
+ * d1 at 0 and h: a speed's maximum inside a step, estimated from the step's ends. */
+double bk_run_hermite_peak(double u0, double d0, double u1, double d1, double h);
 
 /* ---- run_clock.c ---- */
 double bk_run_wall_seconds(void);

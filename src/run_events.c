@@ -158,7 +158,8 @@ int bk_run_island_step(run_ctx *ctx, size_t id)
     }
     if (rc != BK_OK)
         return rc;
-    if ((rc = bk_run_catalog_island_step(ctx, isl)) != BK_OK)
+    if ((rc = bk_run_catalog_island_step(ctx, isl)) != BK_OK ||
+        (rc = bk_run_ruptures_island_step(ctx, isl)) != BK_OK)
         return rc;
     bk_heap_set(&ctx->island_queue, id, island_key(isl));
     /* Every step, so that a wall-clock limit bites inside long segments. */

@@ -58,8 +58,9 @@ int bk_run_restart_all(run_ctx *ctx, double t, int restart_point)
             .kinetic_initial = ctx->kinetic0,
             .t_last_row = ctx->t_last_row,
             .steps_since_row = ctx->steps_since_row,
-            .catalog = bk_run_catalog_save(ctx),
         };
+        if ((rc = bk_run_catalog_save(ctx, &cp.catalog)) != BK_OK)
+            return rc;
         cp.stats = *ctx->stats;
         bk_run_collect_stats(ctx, &cp.stats, ctx->cpu0);
         rc = ctx->sink->checkpoint(ctx->sink->self, &cp, ctx->err);

@@ -48,7 +48,7 @@ int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_
     /* The catalog takes them in the order /transitions holds them, so that it is the
      * catalog rebuilt from that table bit for bit. */
     int written = writes_transitions(ctx);
-    if (!written && !ctx->catalog)
+    if (!written && !ctx->catalog && !ctx->ruptures)
         return BK_OK;
     int rc = written ? bk_run_count_bytes(ctx, BK_TRANSITION_RECORD_BYTES, t) : BK_OK;
     if (rc != BK_OK)
@@ -63,6 +63,13 @@ int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_
     ctx->t_instant = t;
     ctx->instant[ctx->n_instant++] = record;
     return BK_OK;
+}
+
+/* The event and the rupture catalogs see every transition, crossings included. */
+static int to_catalogs(run_ctx *ctx, const bk_transition *transition)
+{
+    int rc = bk_run_catalog_transition(ctx, transition);
+    return rc == BK_OK ? bk_run_ruptures_transition(ctx, transition) : rc;
 }
 
 int bk_run_flush_instant(run_ctx *ctx)
@@ -80,7 +87,7 @@ int bk_run_flush_instant(run_ctx *ctx)
     }
     int written = writes_transitions(ctx);
     for (size_t k = 0; k < n; ++k) {
-        int rc = bk_run_catalog_transition(ctx, &ctx->instant[k]);
+        int rc = to_catalogs(ctx, &ctx->instant[k]);
         if (rc == BK_OK && written)
             rc = ctx->sink->transition(ctx->sink->self, &ctx->instant[k], ctx->err);
         if (rc != BK_OK)
@@ -120,5 +127,5 @@ int bk_run_record_crossing(run_ctx *ctx, double t, size_t i)
         .v = scene->v[i],
         .force = bk_scene_applied_force(scene, i, driver_pos),
     };
-    return bk_run_catalog_transition(ctx, &crossing);
+    return to_catalogs(ctx, &crossing);
 }

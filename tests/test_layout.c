@@ -85,6 +85,11 @@ static void test_dataset_names(void **state)
     bk_output_dataset_names(BK_FIELD_ALL, 0, 1, 1, 1, names, sizeof names);
     assert_string_equal(names, "time,driver,event,x,v,friction,cof,mode,energy_kinetic,"
                                "energy_elastic,work_driver,dissipation,damping_dissipation,transitions,events");
+    bk_output_dataset_names(BK_FIELD_V, 0, 0, 0, BK_CATALOG_EVENTS | BK_CATALOG_RUPTURES | BK_CATALOG_RUPTURE_RATE,
+                            names, sizeof names);
+    assert_string_equal(names, "time,driver,event,v,events,ruptures,rupture_blocks,rupture_rate");
+    bk_output_dataset_names(BK_FIELD_V, 0, 0, 1, BK_CATALOG_EVENTS | BK_CATALOG_RUPTURES, names, sizeof names);
+    assert_string_equal(names, "time,driver,event,v,transitions,events,ruptures,rupture_blocks");
     bk_output_dataset_names(BK_FIELD_V | BK_FIELD_STATE, 0, 1, 0, 0, names, sizeof names);
     assert_string_equal(names, "time,driver,event,v");
 }

@@ -84,6 +84,11 @@ typedef struct bk_catalog_state {
     long first_block, n_episodes;
     double potency, max_slip_rate;
     long events;          /* events completed so far (rows of /events) */
+    /* The rupture builder's open ruptures and counts (bk_ruptures_save), when the run keeps
+     * them: rupture_state_count values, the count right after the pointer (the checkpoint's
+     * table describes both as one variable-length field). */
+    double *rupture_state;
+    long rupture_state_count;
 } bk_catalog_state;
 
 /* Copy the builder's state out (arrays of the state allocated by the caller), or back in

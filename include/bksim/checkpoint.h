@@ -40,7 +40,8 @@ struct bk_checkpoint {
 };
 
 /* Allocate the arrays of a checkpoint for n blocks and s states (free with
- * bk_checkpoint_free); BK_ERR_NOMEM on failure (nothing left allocated). */
+ * bk_checkpoint_free; variable fields are allocated by whoever fills them, with malloc);
+ * BK_ERR_NOMEM on failure (nothing left allocated). */
 int bk_checkpoint_alloc(bk_checkpoint *checkpoint, size_t n_blocks, size_t n_state);
 /* Add the catalog part (its arrays for n_blocks); BK_ERR_NOMEM on failure. */
 int bk_checkpoint_alloc_catalog(bk_checkpoint *checkpoint);
@@ -58,7 +59,10 @@ typedef enum bk_checkpoint_type {
 typedef enum bk_checkpoint_extent {
     BK_CHECKPOINT_SCALAR,    /* the member itself */
     BK_CHECKPOINT_PER_BLOCK, /* a pointer to n_blocks values */
-    BK_CHECKPOINT_PER_STATE  /* a pointer to n_state values */
+    BK_CHECKPOINT_PER_STATE, /* a pointer to n_state values */
+    BK_CHECKPOINT_VARIABLE   /* a pointer to doubles and, right after it, a long holding their
+                                count: stored (and hashed) only when the count is non-zero, so
+                                files written without the field verify as they did */
 } bk_checkpoint_extent;
 
 typedef struct bk_checkpoint_field {
@@ -83,7 +87,8 @@ size_t bk_checkpoint_type_size(bk_checkpoint_type type);
 int bk_checkpoint_field_present(const bk_checkpoint_field *field, const bk_checkpoint *cp);
 /* Whether a slot holds the field: present, and non-zero if it is an if_nonzero one. */
 int bk_checkpoint_field_stored(const bk_checkpoint_field *field, const bk_checkpoint *cp);
-/* Values the field holds in this checkpoint: 1, n_blocks or n_state (0 when absent). */
+/* Values the field holds in this checkpoint: 1, n_blocks, n_state or a variable field's
+ * count (0 when absent). */
 size_t bk_checkpoint_field_count(const bk_checkpoint_field *field, const bk_checkpoint *cp);
 /* Where the values are: the array for array fields, the member itself for scalars.  NULL when
  * absent. */

@@ -79,6 +79,8 @@ typedef struct bk_catalog_options {
     double magnitude_offset;    /* added to (2/3) log10(potency / 1 m); default 0 */
     double slip_rate_threshold; /* m/s: a block of a law without a stuck state slips (for the
                                    catalog) while |v| exceeds it; NaN = none given */
+    int rupture_rate;              /* write /rupture_rate, each rupture's moment-rate function;
+                                      default 1 */
 } bk_catalog_options;
 
 /* A key given as a distribution ([block] mass = normal(1, 0.1)): the value every block ended

@@ -50,6 +50,12 @@ int bk_h5_export(const char *path, const char *datasets, long block, int transit
  * event fields, is an error that names the file and /events. */
 int bk_h5_export_events(const char *path, FILE *out, bk_error *err);
 
+/* Any 1-D table of records (/transitions, /events, /ruptures, /rupture_blocks,
+ * /rupture_rate, or another program's) as TSV on out: a '#' header naming each field with
+ * its unit from the table's units attribute ("1" when it names none), then one row per
+ * record, floating-point fields as %.17g, integers as integers; read 4096 rows at a time. */
+int bk_h5_export_table(const char *path, const char *table, FILE *out, bk_error *err);
+
 /* Read a whole numeric dataset as doubles (row-major, rows x cols; cols = 1 for 1-D).
  * *data is malloc'ed. */
 int bk_h5_read_doubles(const char *path, const char *dataset, double **data, size_t *rows,
@@ -59,6 +65,11 @@ int bk_h5_read_transitions(const char *path, bk_transition **rows, size_t *count
                            bk_error *err);
 /* Read /events (a catalog written by bksim: every bk_event field); *rows malloc'ed. */
 int bk_h5_read_events(const char *path, bk_event **rows, size_t *count, bk_error *err);
+/* Read /ruptures, /rupture_blocks, /rupture_rate (bksim/rupture.h); *rows malloc'ed.
+ * BK_ERR_INVALID when the file has no such table. */
+int bk_h5_read_ruptures(const char *path, bk_rupture **rows, size_t *count, bk_error *err);
+int bk_h5_read_rupture_blocks(const char *path, bk_rupture_block **rows, size_t *count, bk_error *err);
+int bk_h5_read_rupture_rate(const char *path, bk_rupture_rate **rows, size_t *count, bk_error *err);
 
 /* An earthquake catalog's /events table (any HDF5 file: a 1-D compound dataset with at least
  * t_start and magnitude; potency, n_blocks, complete and t_end read when present, in any

@@ -1,5 +1,6 @@
 /* What a run hands on, and to what: the records (a time-series row, a transition, the run's
- * statistics) and the sink that takes them, with a checkpoint and the catalog's events; and
+ * statistics) and the sink that takes them, with a checkpoint and the catalogs' events and
+ * ruptures; and
  * its progress, to a callback that may stop it.
  * Everything that writes, reads or keeps a run's records includes this header rather than
  * the run loop's, which it need not see. */
@@ -56,6 +57,10 @@ typedef struct bk_transition {
 typedef struct bk_checkpoint bk_checkpoint;
 /* An event of the catalog (bksim/catalog.h). */
 typedef struct bk_event bk_event;
+/* A rupture, its blocks and its moment-rate samples (bksim/rupture.h). */
+typedef struct bk_rupture bk_rupture;
+typedef struct bk_rupture_block bk_rupture_block;
+typedef struct bk_rupture_rate bk_rupture_rate;
 
 typedef struct bk_sink {
     void *self;
@@ -66,6 +71,10 @@ typedef struct bk_sink {
     int (*checkpoint)(void *self, const bk_checkpoint *checkpoint, bk_error *err);
     /* Each event of the catalog as it completes ([output] events); may be NULL. */
     int (*event)(void *self, const bk_event *event, bk_error *err);
+    /* Each rupture as it completes, with its blocks and its rate samples (n_rate = 0 when
+     * [catalog] rupture_rate is off); may be NULL. */
+    int (*rupture)(void *self, const bk_rupture *rupture, const bk_rupture_block *blocks, size_t n_blocks,
+                   const bk_rupture_rate *rate, size_t n_rate, bk_error *err);
 } bk_sink;
 
 typedef struct bk_run_stats {

@@ -96,6 +96,7 @@ static const char *const info_help =
 static const char *const export_help =
     "usage: bksim export OUT.h5 [--datasets a,b,...] [--block I] [--transitions]\n"
     "       bksim export OUT.h5 --events\n"
+    "       bksim export OUT.h5 --table NAME\n"
     "\n"
     "Prints whitespace-separated columns with a '#' header (names and units).\n"
     "  --datasets LIST   comma-separated dataset names (default time,event,driver,x,v,\n"
@@ -106,7 +107,10 @@ static const char *const export_help =
     "  --transitions     print the /transitions table instead\n"
     "  --events          print the event catalog /events instead, tab-separated: one row\n"
     "                    per event, every field (t_start ... complete); on a ring\n"
-    "                    left > right when the extent wraps past block 0\n";
+    "                    left > right when the extent wraps past block 0\n"
+    "  --table NAME      print any table of records as TSV, every field with its unit:\n"
+    "                    ruptures, rupture_blocks, rupture_rate (README \"Ruptures\"),\n"
+    "                    events, transitions\n";
 
 static const char *const stats_help =
     "usage: bksim stats FILE [--mc auto|VALUE] [--bin DM] [--from T] [--to T] [--json]\n"
@@ -571,7 +575,7 @@ static int cmd_export(int argc, char **argv)
         fputs(export_help, stdout);
         return 0;
     }
-    const char *path = NULL, *datasets = NULL;
+    const char *path = NULL, *datasets = NULL, *table = NULL;
     long block = -1;
     int transitions = 0, events = 0;
     for (int i = 0; i < argc; ++i) {
@@ -591,6 +595,10 @@ static int cmd_export(int argc, char **argv)
             transitions = 1;
         } else if (strcmp(a, "--events") == 0) {
             events = 1;
+        } else if (strcmp(a, "--table") == 0 && i + 1 < argc) {
+            table = argv[++i];
+        } else if (strncmp(a, "--table=", 8) == 0) {
+            table = a + 8;
         } else if (a[0] == '-') {
             return usage_error("export", "unknown or incomplete option '%s'", a);
         } else if (!path) {
@@ -604,9 +612,16 @@ static int cmd_export(int argc, char **argv)
     if (events && (datasets || block >= 0 || transitions))
         return usage_error("export", "%s", "--events prints the whole catalog: it takes none "
                                            "of --datasets, --block, --transitions");
+    if (table && (datasets || block >= 0 || transitions || events))
+        return usage_error("export", "%s", "--table prints one whole table: it takes none of --datasets, "
+                                           "--block, --transitions, --events");
+    if (table && !*table)
+        return usage_error("export", "%s", "--table needs a table name (ruptures, rupture_blocks, rupture_rate, "
+                                           "events, transitions)");
     bk_error err = {0};
-    int rc = events ? bk_h5_export_events(path, stdout, &err)
-                    : bk_h5_export(path, datasets, block, transitions, stdout, &err);
+    int rc = table    ? bk_h5_export_table(path, table, stdout, &err)
+             : events ? bk_h5_export_events(path, stdout, &err)
+                      : bk_h5_export(path, datasets, block, transitions, stdout, &err);
     if (rc != BK_OK) {
         fprintf(stderr, "%s\n", err.message);
         return EXIT_RUN_FAILED;

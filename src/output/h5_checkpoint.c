@@ -57,6 +57,52 @@ static herr_t get_array(hid_t group, const char *name, hid_t mem_type, size_t n,
     return rc;
 }
 
+/* A variable field's values in group: a chunked dataset resized to them on every write (a
+ * slot is overwritten in place, and the count changes from one checkpoint to the next). */
+static herr_t put_variable(hid_t group, const char *name, const double *values, size_t n)
+{
+    hid_t dset;
+    hsize_t dims[1] = {n};
+    if (H5Lexists(group, name, H5P_DEFAULT) > 0) {
+        dset = H5Dopen2(group, name, H5P_DEFAULT);
+        if (dset >= 0 && H5Dset_extent(dset, dims) < 0) {
+            CLOSE_IDS(-1, dset);
+            return -1;
+        }
+    } else {
+        hsize_t max_dims[1] = {H5S_UNLIMITED}, chunk[1] = {4096};
+        hid_t space = H5Screate_simple(1, dims, max_dims);
+        hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+        dset = space < 0 || dcpl < 0 || H5Pset_chunk(dcpl, 1, chunk) < 0
+                   ? H5I_INVALID_HID
+                   : H5Dcreate2(group, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+        CLOSE_IDS(0, dcpl, space);
+    }
+    herr_t rc = dset < 0 ? -1 : n ? H5Dwrite(dset, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values) : 0;
+    CLOSE_IDS(rc, dset);
+    return rc;
+}
+
+/* A variable field back: its values malloc'ed into the checkpoint, with their count. */
+static herr_t get_variable(hid_t group, const bk_checkpoint_field *f, bk_checkpoint *cp)
+{
+    hid_t dset = H5Dopen2(group, f->name, H5P_DEFAULT);
+    hid_t space = dset < 0 ? H5I_INVALID_HID : H5Dget_space(dset);
+    hssize_t n = space < 0 ? -1 : H5Sget_simple_extent_npoints(space);
+    double *values = n > 0 && (size_t)n <= SIZE_MAX / sizeof(double) ? malloc((size_t)n * sizeof *values) : NULL;
+    herr_t rc = values && H5Dread(dset, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values) >= 0 ? 0 : -1;
+    CLOSE_IDS(rc, space, dset);
+    if (rc < 0) {
+        free(values);
+        return -1;
+    }
+    char *member = (f->catalog ? (char *)cp->catalog : (char *)cp) + f->offset;
+    long count = (long)n;
+    memcpy(member, &values, sizeof values);
+    memcpy(member + sizeof values, &count, sizeof count);
+    return 0;
+}
+
 /* The group name in parent, created when missing; *created tells which. */
 static hid_t open_or_create_group(hid_t parent, const char *name, int *created)
 {
@@ -108,6 +154,8 @@ static hid_t field_mem_type(bk_checkpoint_type type)
 static herr_t put_field(hid_t group, const bk_checkpoint_field *f, const bk_checkpoint *cp)
 {
     const void *data = bk_checkpoint_field_cdata(f, cp);
+    if (f->extent == BK_CHECKPOINT_VARIABLE)
+        return put_variable(group, f->name, data, bk_checkpoint_field_count(f, cp));
     if (f->extent != BK_CHECKPOINT_SCALAR)
         return put_array(group, f->name, field_file_type(f->type), field_mem_type(f->type),
                          bk_checkpoint_field_count(f, cp), data);
@@ -127,6 +175,8 @@ static herr_t put_field(hid_t group, const bk_checkpoint_field *f, const bk_chec
 /* The same field back from a slot into cp (its arrays allocated for the slot's counts). */
 static herr_t get_field(hid_t group, const bk_checkpoint_field *f, bk_checkpoint *cp)
 {
+    if (f->extent == BK_CHECKPOINT_VARIABLE)
+        return get_variable(group, f, cp);
     void *data = bk_checkpoint_field_data(f, cp);
     if (f->extent != BK_CHECKPOINT_SCALAR)
         return get_array(group, f->name, field_mem_type(f->type), bk_checkpoint_field_count(f, cp),
@@ -368,7 +418,10 @@ static int read_slot(hid_t file, hid_t top, const char *name, size_t n_blocks,
     herr_t ok = has_catalog == 0 || has_catalog == 1 ? 0 : -1;
     for (size_t k = 0; ok >= 0 && k < bk_checkpoint_n_fields; ++k) {
         const bk_checkpoint_field *f = &bk_checkpoint_fields[k];
-        int present = f->if_nonzero ? H5Aexists(group, f->name) > 0 : bk_checkpoint_field_present(f, cp);
+        int present = f->extent == BK_CHECKPOINT_VARIABLE
+                          ? bk_checkpoint_field_present(f, cp) && H5Lexists(group, f->name, H5P_DEFAULT) > 0
+                      : f->if_nonzero ? H5Aexists(group, f->name) > 0
+                                      : bk_checkpoint_field_present(f, cp);
         if (present)
             ok = get_field(group, f, cp);
     }

@@ -356,3 +356,113 @@ int bk_h5_export_events(const char *path, FILE *out, bk_error *err)
         rc = BK_FAIL(err, BK_ERR_IO, "%s: writing the export failed", path);
     return rc;
 }
+
+/* ------------------------------------------------------- any record table --- */
+
+/* The unit of member name in a "name: unit, name: unit" list; "" when not listed. */
+static void unit_of(const char *units, const char *name, char *out, size_t len)
+{
+    out[0] = '\0';
+    size_t n = strlen(name);
+    for (const char *p = units; p && *p;) {
+        while (*p == ' ' || *p == ',')
+            p++;
+        if (strncmp(p, name, n) == 0 && p[n] == ':') {
+            p += n + 1;
+            while (*p == ' ')
+                p++;
+            size_t k = 0;
+            while (p[k] && p[k] != ',' && k + 1 < len) {
+                out[k] = p[k];
+                k++;
+            }
+            out[k] = '\0';
+            return;
+        }
+        p = strchr(p, ',');
+    }
+}
+
+int bk_h5_export_table(const char *path, const char *name, FILE *out, bk_error *err)
+{
+    if (!out || !name || !*name)
+        return BK_FAIL(err, BK_ERR_INVALID, "bk_h5_export_table: needs a table name and an output stream");
+    hid_t file;
+    int rc = bk_h5_open_input(path, &file, err);
+    if (rc != BK_OK)
+        return rc;
+    hid_t dset = H5I_INVALID_HID, type = H5I_INVALID_HID, space = H5I_INVALID_HID, mem = H5I_INVALID_HID;
+    int members = 0;
+    hsize_t rows = 0;
+    if (H5Lexists(file, name, H5P_DEFAULT) <= 0 || (dset = H5Dopen2(file, name, H5P_DEFAULT)) < 0) {
+        rc = BK_FAIL(err, BK_ERR_INVALID, "%s: no table /%s (bksim writes transitions, events, ruptures, "
+                     "rupture_blocks, rupture_rate)", path, name);
+    } else {
+        type = H5Dget_type(dset);
+        space = H5Dget_space(dset);
+        if (type < 0 || space < 0 || H5Tget_class(type) != H5T_COMPOUND || H5Sget_simple_extent_ndims(space) != 1 ||
+            H5Sget_simple_extent_dims(space, &rows, NULL) < 0 || (members = H5Tget_nmembers(type)) < 1)
+            rc = BK_FAIL(err, BK_ERR_INVALID, "%s: /%s is not a 1-D table of records", path, name);
+    }
+    /* Every member read as a double or a 64-bit integer, in a packed row of 8-byte cells. */
+    int *is_int = NULL;
+    char **names = NULL;
+    if (rc == BK_OK) {
+        is_int = calloc((size_t)members, sizeof *is_int);
+        names = calloc((size_t)members, sizeof *names);
+        mem = H5Tcreate(H5T_COMPOUND, 8 * (size_t)members);
+        if (!is_int || !names || mem < 0)
+            rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory exporting /%s", path, name);
+    }
+    char *units = rc == BK_OK ? bk_h5_read_string_attr(dset, "units") : NULL;
+    for (int k = 0; rc == BK_OK && k < members; ++k) {
+        names[k] = H5Tget_member_name(type, (unsigned)k);
+        is_int[k] = H5Tget_member_class(type, (unsigned)k) == H5T_INTEGER;
+        if (!names[k] || H5Tinsert(mem, names[k], 8 * (size_t)k, is_int[k] ? H5T_NATIVE_LLONG : H5T_NATIVE_DOUBLE) < 0)
+            rc = H5_FAIL(err, "%s: cannot read the fields of /%s", path, name);
+    }
+    if (rc == BK_OK) {
+        fputc('#', out);
+        for (int k = 0; k < members; ++k) {
+            char unit[32];
+            unit_of(units, names[k], unit, sizeof unit);
+            fprintf(out, "%s%s[%s]", k ? "\t" : " ", names[k], unit[0] ? unit : "1");
+        }
+        fputc('\n', out);
+    }
+    const hsize_t chunk = 4096;
+    unsigned char *buf = rc == BK_OK ? malloc((size_t)chunk * 8 * (size_t)members) : NULL;
+    if (rc == BK_OK && !buf)
+        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory exporting /%s", path, name);
+    for (hsize_t start = 0; rc == BK_OK && start < rows; start += chunk) {
+        hsize_t n = rows - start < chunk ? rows - start : chunk;
+        if (bk_h5_read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
+            rc = H5_DAMAGED(err, "%s: damaged: /%s rows %llu..%llu cannot be read", path, name,
+                            (unsigned long long)start, (unsigned long long)(start + n - 1));
+            break;
+        }
+        for (hsize_t r = 0; r < n; ++r)
+            for (int k = 0; k < members; ++k) {
+                const unsigned char *cell = buf + ((size_t)r * (size_t)members + (size_t)k) * 8;
+                if (is_int[k]) {
+                    long long v;
+                    memcpy(&v, cell, sizeof v);
+                    fprintf(out, "%lld%c", v, k + 1 < members ? '\t' : '\n');
+                } else {
+                    double v;
+                    memcpy(&v, cell, sizeof v);
+                    fprintf(out, "%.17g%c", v, k + 1 < members ? '\t' : '\n');
+                }
+            }
+    }
+    free(buf);
+    free(units);
+    for (int k = 0; names && k < members; ++k)
+        H5free_memory(names[k]);
+    free(names);
+    free(is_int);
+    CLOSE_IDS(rc, mem, space, type, dset, file);
+    if (rc == BK_OK && (fflush(out) != 0 || ferror(out)))
+        rc = BK_FAIL(err, BK_ERR_IO, "%s: writing the export failed", path);
+    return rc;
+}

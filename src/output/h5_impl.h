@@ -18,6 +18,7 @@
 #include "bksim/checkpoint.h"
 #include "bksim/config.h"
 #include "bksim/output.h"
+#include "bksim/rupture.h"
 #include "layout.h"
 
 /* Rows of a 2-D chunk, and of the buffer that fills one.  A chunk of a T x N dataset is
@@ -30,6 +31,9 @@
 #define SERIES_1D_CHUNK 4096u
 #define TRANSITION_BUFFER 512u
 #define EVENT_BUFFER 256u
+#define RUPTURE_BUFFER 256u
+#define RUPTURE_BLOCK_BUFFER 1024u
+#define RUPTURE_RATE_BUFFER 2048u
 /* Wall-clock seconds between two commits (H5Fflush: what is on disk becomes a readable
  * file) while a run writes; a SIGKILL loses what came after the last one. */
 #define COMMIT_INTERVAL 1.0
@@ -50,7 +54,24 @@ typedef struct bk_h5_series {
     unsigned char *buf;  /* rows x cols values */
 } bk_h5_series;
 
-/* A table of packed records (/transitions, /events) and its buffer. */
+/* The record tables, in the order the writer creates them. */
+typedef enum bk_h5_table_kind {
+    BK_TABLE_TRANSITIONS, BK_TABLE_EVENTS, BK_TABLE_RUPTURES, BK_TABLE_RUPTURE_BLOCKS,
+    BK_TABLE_RUPTURE_RATE, BK_N_TABLES
+} bk_h5_table_kind;
+
+/* What a table is: its dataset's name and attributes, its record on disk and in memory, and
+ * the records its buffer (one chunk) holds. */
+typedef struct bk_h5_table_def {
+    const char *name, *units, *description;
+    size_t record_bytes;  /* packed, on disk */
+    size_t struct_bytes;  /* the C struct (bk_transition, bk_event, bk_rupture, ...) */
+    size_t buffer;        /* records per chunk */
+} bk_h5_table_def;
+
+extern const bk_h5_table_def bk_h5_tables[BK_N_TABLES];
+
+/* A table of packed records and its buffer. */
 typedef struct bk_h5_table {
     hid_t dset;          /* H5I_INVALID_HID when the table is not written */
     hid_t mem;           /* the C struct's type, for reading back at a restart */
@@ -72,9 +93,8 @@ struct bk_h5_writer {
     hsize_t rows;        /* rows accepted; every series holds them, on disk or buffered */
     double t_buffered;   /* time of the last row accepted */
     double t_written;    /* time of the last row in the last commit */
-    bk_h5_table trans;
+    bk_h5_table tables[BK_N_TABLES]; /* dset invalid for a table the run does not write */
     double trans_last_t; /* t of the last transition accepted */
-    bk_h5_table events;  /* dset invalid when the run keeps no catalog */
     double last_commit;  /* wall clock (s) of the last commit */
     int part_fd;         /* the .part opened for write-behind (-1: not yet) */
     size_t unsynced;     /* bytes appended since the last write-behind */
@@ -92,8 +112,8 @@ int bk_h5_writer_new(bk_h5_writer **out, const char *path, bk_error *err);
 void bk_h5_writer_size(bk_h5_writer *w, const bk_model *model);
 /* Shape series i for this chain and allocate its row buffer; -1 when out of memory. */
 int bk_h5_writer_series(bk_h5_writer *w, int i, const bk_model *model);
-/* The buffer and memory types of /transitions (events = 0) or /events; -1 on failure. */
-int bk_h5_writer_table(bk_h5_table *table, int events);
+/* The buffer and memory types of a table; -1 on failure. */
+int bk_h5_writer_table(bk_h5_table *table, bk_h5_table_kind kind);
 /* Close every id the writer holds; -1 if any close failed. */
 herr_t bk_h5_writer_close(bk_h5_writer *w);
 void bk_h5_writer_free(bk_h5_writer *w);
@@ -153,7 +173,10 @@ hid_t bk_h5_kind_mem_type(bk_series_kind kind);
 typedef enum { BK_H5_RECORD_STRUCT, BK_H5_RECORD_FILE, BK_H5_RECORD_PACKED } bk_h5_record_layout;
 hid_t bk_h5_transition_type(bk_h5_record_layout layout);
 hid_t bk_h5_event_type(bk_h5_record_layout layout);
-/* The record as a packed row (BK_*_RECORD_BYTES bytes at row). */
+/* Any table's record type. */
+hid_t bk_h5_table_type(bk_h5_table_kind kind, bk_h5_record_layout layout);
+/* The record as a packed row (record_bytes at row). */
+void bk_h5_pack_record(bk_h5_table_kind kind, const void *record, unsigned char *row);
 void bk_h5_pack_transition(const bk_transition *transition, unsigned char *row);
 void bk_h5_pack_event(const bk_event *event, unsigned char *row);
 

@@ -509,3 +509,59 @@ int bk_h5_read_events(const char *path, bk_event **rows, size_t *count, bk_error
     CLOSE_IDS(rc, mem, dset, file);
     return rc;
 }
+
+/* A whole rupture table of kind (its C records); BK_ERR_INVALID when the file has none. */
+static int read_rupture_table(const char *path, bk_h5_table_kind kind, void **rows, size_t *count, bk_error *err)
+{
+    const char *name = bk_h5_tables[kind].name;
+    if (!rows || !count)
+        return BK_FAIL(err, BK_ERR_INVALID, "reading /%s: missing argument", name);
+    *rows = NULL;
+    *count = 0;
+    hid_t file, dset = H5I_INVALID_HID, mem = H5I_INVALID_HID, space = H5I_INVALID_HID;
+    int rc = bk_h5_open_input(path, &file, err);
+    if (rc != BK_OK)
+        return rc;
+    if (H5Lexists(file, name, H5P_DEFAULT) <= 0)
+        rc = BK_FAIL(err, BK_ERR_INVALID, "%s: no /%s table (the rupture catalog of a chain run with [output] "
+                     "events = true%s)", path, name,
+                     kind == BK_TABLE_RUPTURE_RATE ? " and [catalog] rupture_rate = true" : "");
+    hsize_t n = 0;
+    if (rc == BK_OK) {
+        dset = H5Dopen2(file, name, H5P_DEFAULT);
+        space = dset < 0 ? H5I_INVALID_HID : H5Dget_space(dset);
+        mem = bk_h5_table_type(kind, BK_H5_RECORD_STRUCT);
+        if (space < 0 || mem < 0 || H5Sget_simple_extent_ndims(space) != 1 ||
+            H5Sget_simple_extent_dims(space, &n, NULL) < 0)
+            rc = H5_DAMAGED(err, "%s: damaged: /%s cannot be read", path, name);
+    }
+    size_t size = bk_h5_tables[kind].struct_bytes;
+    void *values = NULL;
+    if (rc == BK_OK && !(values = n > SIZE_MAX / size ? NULL : calloc(n ? (size_t)n : 1, size)))
+        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory reading /%s", path, name);
+    else if (rc == BK_OK && n > 0 && H5Dread(dset, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, values) < 0)
+        rc = H5_DAMAGED(err, "%s: damaged: /%s cannot be read (not bksim's rupture table?)", path, name);
+    if (rc == BK_OK) {
+        *rows = values;
+        *count = (size_t)n;
+    } else {
+        free(values);
+    }
+    CLOSE_IDS(rc, space, mem, dset, file);
+    return rc;
+}
+
+int bk_h5_read_ruptures(const char *path, bk_rupture **rows, size_t *count, bk_error *err)
+{
+    return read_rupture_table(path, BK_TABLE_RUPTURES, (void **)rows, count, err);
+}
+
+int bk_h5_read_rupture_blocks(const char *path, bk_rupture_block **rows, size_t *count, bk_error *err)
+{
+    return read_rupture_table(path, BK_TABLE_RUPTURE_BLOCKS, (void **)rows, count, err);
+}
+
+int bk_h5_read_rupture_rate(const char *path, bk_rupture_rate **rows, size_t *count, bk_error *err)
+{
+    return read_rupture_table(path, BK_TABLE_RUPTURE_RATE, (void **)rows, count, err);
+}

@@ -137,30 +137,46 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
                 rc = H5_FAIL(err, "%s: cannot reopen /%s at the checkpoint's %llu rows", w->part,
                              bk_series[i].name, (unsigned long long)rows);
         }
-        if (rc == BK_OK && H5Lexists(w->file, "transitions", H5P_DEFAULT) > 0) {
-            int buffered = bk_h5_writer_table(&w->trans, 0);
-            w->trans.dset = H5Dopen2(w->file, "transitions", H5P_DEFAULT);
-            if (buffered < 0 || w->trans.dset < 0 ||
-                truncate_rows(w->trans.dset, (hsize_t)rec->transition_rows, w->trans.mem,
-                              sizeof(bk_transition)) < 0)
-                rc = H5_FAIL(err, "%s: cannot reopen /transitions at the checkpoint", w->part);
+        /* Each table to the rows the checkpoint counts: /transitions by its record, /events
+         * and the rupture tables by the catalog it carries (both or neither). */
+        long long counts[BK_N_TABLES] = {rec->transition_rows, -1, -1, -1, -1};
+        if (cp->catalog) {
+            counts[BK_TABLE_EVENTS] = cp->catalog->events;
+            long ruptures, block_rows, rate_rows;
+            if (bk_ruptures_saved_counts(cp->catalog->rupture_state, (size_t)cp->catalog->rupture_state_count,
+                                         &ruptures, &block_rows, &rate_rows) == BK_OK) {
+                counts[BK_TABLE_RUPTURES] = ruptures;
+                counts[BK_TABLE_RUPTURE_BLOCKS] = block_rows;
+                counts[BK_TABLE_RUPTURE_RATE] = rate_rows;
+            }
         }
-        /* /events goes with a checkpoint that carries the catalog: both, or neither. */
-        int has_events = rc == BK_OK ? H5Lexists(w->file, "events", H5P_DEFAULT) > 0 : 0;
-        if (rc == BK_OK && has_events != (cp->catalog != NULL))
-            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: %s", w->part,
-                         has_events ? "/events exists but the checkpoint holds no catalog"
-                                    : "the checkpoint holds a catalog but there is no /events");
-        if (rc == BK_OK && has_events) {
-            int buffered = bk_h5_writer_table(&w->events, 1);
-            w->events.dset = H5Dopen2(w->file, "events", H5P_DEFAULT);
-            if (buffered < 0 || w->events.dset < 0 ||
-                truncate_rows(w->events.dset, (hsize_t)cp->catalog->events, w->events.mem, sizeof(bk_event)) < 0)
-                rc = H5_FAIL(err, "%s: cannot reopen /events at the checkpoint", w->part);
-            w->events.written = (hsize_t)cp->catalog->events;
+        for (int k = 0; rc == BK_OK && k < BK_N_TABLES; ++k) {
+            const char *name = bk_h5_tables[k].name;
+            int exists = H5Lexists(w->file, name, H5P_DEFAULT) > 0;
+            /* /transitions and /rupture_rate are optional; the other tables go with the
+             * catalog the checkpoint carries, both or neither. */
+            int optional = k == BK_TABLE_TRANSITIONS || k == BK_TABLE_RUPTURE_RATE;
+            if (exists && counts[k] < 0) {
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /%s exists but the checkpoint holds no "
+                             "catalog for it", w->part, name);
+                break;
+            }
+            if (!exists && counts[k] >= 0 && !optional) {
+                rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: the checkpoint holds a catalog but there "
+                             "is no /%s", w->part, name);
+                break;
+            }
+            if (!exists)
+                continue;
+            bk_h5_table *t = &w->tables[k];
+            int buffered = bk_h5_writer_table(t, (bk_h5_table_kind)k);
+            t->dset = H5Dopen2(w->file, name, H5P_DEFAULT);
+            if (buffered < 0 || t->dset < 0 ||
+                truncate_rows(t->dset, (hsize_t)counts[k], t->mem, bk_h5_tables[k].struct_bytes) < 0)
+                rc = H5_FAIL(err, "%s: cannot reopen /%s at the checkpoint", w->part, name);
+            t->written = (hsize_t)counts[k];
         }
         w->rows = rows;
-        w->trans.written = (hsize_t)rec->transition_rows;
         w->trans_last_t = rec->last_transition_t;
         w->t_written = w->t_buffered = cp->t_last_row;
         /* The next checkpoint goes into the other slot: this one stays the fallback. */

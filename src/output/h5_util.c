@@ -316,7 +316,7 @@ hid_t bk_h5_kind_mem_type(bk_series_kind kind)
 typedef struct record_field {
     const char *name;
     size_t offset, packed_offset;
-    int kind; /* 0: double, 1: int32, 2: int8 */
+    int kind; /* 0: double, 1: int32, 2: int8, 3: int64 */
 } record_field;
 
 static const record_field transition_fields[] = {
@@ -344,9 +344,65 @@ static const record_field event_fields[] = {
     {"complete", offsetof(bk_event, complete), 68, 2},
 };
 
+static const record_field rupture_fields[] = {
+    {"t_start", offsetof(bk_rupture, t_start), 0, 0},
+    {"t_end", offsetof(bk_rupture, t_end), 8, 0},
+    {"first_block", offsetof(bk_rupture, first_block), 16, 1},
+    {"n_blocks", offsetof(bk_rupture, n_blocks), 20, 1},
+    {"left", offsetof(bk_rupture, left), 24, 1},
+    {"right", offsetof(bk_rupture, right), 28, 1},
+    {"n_episodes", offsetof(bk_rupture, n_episodes), 32, 1},
+    {"potency", offsetof(bk_rupture, potency), 36, 0},
+    {"magnitude", offsetof(bk_rupture, magnitude), 44, 0},
+    {"max_slip_rate", offsetof(bk_rupture, max_slip_rate), 52, 0},
+    {"stress_drop", offsetof(bk_rupture, stress_drop), 60, 0},
+    {"duration", offsetof(bk_rupture, duration), 68, 0},
+    {"front_speed_left", offsetof(bk_rupture, front_speed_left), 76, 0},
+    {"front_speed_right", offsetof(bk_rupture, front_speed_right), 84, 0},
+    {"complete", offsetof(bk_rupture, complete), 92, 2},
+};
+
+static const record_field rupture_block_fields[] = {
+    {"rupture", offsetof(bk_rupture_block, rupture), 0, 3},
+    {"block", offsetof(bk_rupture_block, block), 8, 1},
+    {"t_onset", offsetof(bk_rupture_block, t_onset), 12, 0},
+    {"t_stop", offsetof(bk_rupture_block, t_stop), 20, 0},
+    {"slip", offsetof(bk_rupture_block, slip), 28, 0},
+};
+
+static const record_field rupture_rate_fields[] = {
+    {"rupture", offsetof(bk_rupture_rate, rupture), 0, 3},
+    {"t", offsetof(bk_rupture_rate, t), 8, 0},
+    {"rate", offsetof(bk_rupture_rate, rate), 16, 0},
+};
+
 #define N_FIELDS(table) (sizeof table / sizeof table[0])
 
-static const size_t kind_size[] = {8, 4, 1};
+const bk_h5_table_def bk_h5_tables[BK_N_TABLES] = {
+    {"transitions", BK_TRANSITIONS_UNITS, BK_TRANSITIONS_DESCRIPTION, BK_TRANSITION_RECORD_BYTES,
+     sizeof(bk_transition), TRANSITION_BUFFER},
+    {"events", BK_EVENTS_UNITS, BK_EVENTS_DESCRIPTION, BK_EVENT_RECORD_BYTES, sizeof(bk_event), EVENT_BUFFER},
+    {"ruptures", BK_RUPTURES_UNITS, BK_RUPTURES_DESCRIPTION, BK_RUPTURE_RECORD_BYTES, sizeof(bk_rupture),
+     RUPTURE_BUFFER},
+    {"rupture_blocks", BK_RUPTURE_BLOCKS_UNITS, BK_RUPTURE_BLOCKS_DESCRIPTION, BK_RUPTURE_BLOCK_RECORD_BYTES,
+     sizeof(bk_rupture_block), RUPTURE_BLOCK_BUFFER},
+    {"rupture_rate", BK_RUPTURE_RATE_UNITS, BK_RUPTURE_RATE_DESCRIPTION, BK_RUPTURE_RATE_RECORD_BYTES,
+     sizeof(bk_rupture_rate), RUPTURE_RATE_BUFFER},
+};
+
+/* Each table's fields, by bk_h5_table_kind. */
+static const struct {
+    const record_field *fields;
+    size_t n;
+} table_fields[BK_N_TABLES] = {
+    {transition_fields, N_FIELDS(transition_fields)},
+    {event_fields, N_FIELDS(event_fields)},
+    {rupture_fields, N_FIELDS(rupture_fields)},
+    {rupture_block_fields, N_FIELDS(rupture_block_fields)},
+    {rupture_rate_fields, N_FIELDS(rupture_rate_fields)},
+};
+
+static const size_t kind_size[] = {8, 4, 1, 8};
 
 static hid_t record_type(const record_field *fields, size_t n, size_t struct_size,
                          size_t packed_size, bk_h5_record_layout layout)
@@ -358,6 +414,7 @@ static hid_t record_type(const record_field *fields, size_t n, size_t struct_siz
         int file = layout == BK_H5_RECORD_FILE;
         hid_t member = fields[k].kind == 0 ? (file ? H5T_IEEE_F64LE : H5T_NATIVE_DOUBLE)
                        : fields[k].kind == 1 ? (file ? H5T_STD_I32LE : H5T_NATIVE_INT32)
+                       : fields[k].kind == 3 ? (file ? H5T_STD_I64LE : H5T_NATIVE_INT64)
                                              : (file ? H5T_STD_I8LE : H5T_NATIVE_INT8);
         rc = H5Tinsert(type, fields[k].name, packed ? fields[k].packed_offset : fields[k].offset, member);
     }
@@ -385,6 +442,17 @@ hid_t bk_h5_event_type(bk_h5_record_layout layout)
 {
     return record_type(event_fields, N_FIELDS(event_fields), sizeof(bk_event), BK_EVENT_RECORD_BYTES,
                        layout);
+}
+
+hid_t bk_h5_table_type(bk_h5_table_kind kind, bk_h5_record_layout layout)
+{
+    return record_type(table_fields[kind].fields, table_fields[kind].n, bk_h5_tables[kind].struct_bytes,
+                       bk_h5_tables[kind].record_bytes, layout);
+}
+
+void bk_h5_pack_record(bk_h5_table_kind kind, const void *record, unsigned char *row)
+{
+    pack(table_fields[kind].fields, table_fields[kind].n, record, row);
 }
 
 void bk_h5_pack_transition(const bk_transition *transition, unsigned char *row)

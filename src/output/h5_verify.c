@@ -240,7 +240,8 @@ static char *expected_datasets(hid_t file)
     if (bk_h5_load_stored_config(file, "", &config, &ignored) == BK_OK)
         bk_output_dataset_names(config->output.fields, config->model->n_friction_state,
                                 bk_model_is_damped(config->model), config->output.transitions,
-                                config->output.events, list, sizeof list);
+                                /* files without the record predate the rupture tables */
+                                config->output.events ? BK_CATALOG_EVENTS : 0u, list, sizeof list);
     bk_config_free(config);
     return strdup(list);
 }

@@ -110,6 +110,14 @@ static herr_t write_state_blocks(hid_t dset, const bk_model *model)
     return rc;
 }
 
+/* The catalog tables a run of this config writes (BK_CATALOG_*). */
+static unsigned catalog_mask(const bk_config *config)
+{
+    if (!config->output.events)
+        return 0u;
+    return BK_CATALOG_EVENTS | BK_CATALOG_RUPTURES | (config->catalog.rupture_rate ? BK_CATALOG_RUPTURE_RATE : 0u);
+}
+
 static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err)
 {
     const bk_model *model = config->model;
@@ -166,7 +174,8 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
         stored = bk_h5_write_string_attr(w->file, "overrides", overrides);
     free(overrides);
     char names[BK_DATASET_LIST_LEN];
-    bk_output_dataset_names(fields, n_state, bk_model_is_damped(model), config->output.transitions, config->output.events, names,
+    bk_output_dataset_names(fields, n_state, bk_model_is_damped(model), config->output.transitions,
+                            catalog_mask(config), names,
                             sizeof names);
     if (stored >= 0)
         stored = bk_h5_write_string_attr(w->file, "datasets", names);
@@ -192,27 +201,27 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
             return H5_FAIL(err, "%s: cannot write attribute /friction_state/block", w->part);
     }
 
-    bk_h5_table *tables[2] = {&w->trans, &w->events};
-    const int wanted[2] = {config->output.transitions, config->output.events};
-    static const char *const table_names[2] = {"transitions", "events"};
-    static const char *const table_units[2] = {BK_TRANSITIONS_UNITS, BK_EVENTS_UNITS};
-    static const char *const table_descriptions[2] = {BK_TRANSITIONS_DESCRIPTION, BK_EVENTS_DESCRIPTION};
-    for (int k = 0; k < 2; ++k) {
-        bk_h5_table *t = tables[k];
+    unsigned catalogs = catalog_mask(config);
+    const int wanted[BK_N_TABLES] = {config->output.transitions, (catalogs & BK_CATALOG_EVENTS) != 0,
+                                     (catalogs & BK_CATALOG_RUPTURES) != 0, (catalogs & BK_CATALOG_RUPTURES) != 0,
+                                     (catalogs & BK_CATALOG_RUPTURE_RATE) != 0};
+    for (int k = 0; k < BK_N_TABLES; ++k) {
+        bk_h5_table *t = &w->tables[k];
+        const bk_h5_table_def *def = &bk_h5_tables[k];
         if (!wanted[k])
             continue;
-        if (bk_h5_writer_table(t, k) < 0)
-            return t->buf ? H5_FAIL(err, "%s: cannot create dataset /%s", w->part, table_names[k])
+        if (bk_h5_writer_table(t, (bk_h5_table_kind)k) < 0)
+            return t->buf ? H5_FAIL(err, "%s: cannot create dataset /%s", w->part, def->name)
                           : BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for the /%s buffer",
-                                    w->part, table_names[k]);
-        hid_t disk = k ? bk_h5_event_type(BK_H5_RECORD_FILE) : bk_h5_transition_type(BK_H5_RECORD_FILE);
+                                    w->part, def->name);
+        hid_t disk = bk_h5_table_type((bk_h5_table_kind)k, BK_H5_RECORD_FILE);
         if (disk >= 0)
-            t->dset = create_extendable(w->file, table_names[k], disk, 1, 1, (hsize_t)t->capacity);
+            t->dset = create_extendable(w->file, def->name, disk, 1, 1, (hsize_t)t->capacity);
         CLOSE_IDS(t->dset, disk);
         if (t->dset < 0)
-            return H5_FAIL(err, "%s: cannot create dataset /%s", w->part, table_names[k]);
-        if (bk_h5_describe(t->dset, table_units[k], table_descriptions[k]) < 0)
-            return H5_FAIL(err, "%s: cannot write attributes of /%s", w->part, table_names[k]);
+            return H5_FAIL(err, "%s: cannot create dataset /%s", w->part, def->name);
+        if (bk_h5_describe(t->dset, def->units, def->description) < 0)
+            return H5_FAIL(err, "%s: cannot write attributes of /%s", w->part, def->name);
     }
     int rc = write_parameters(w, config, err);
     if (rc != BK_OK)
@@ -245,9 +254,8 @@ herr_t bk_h5_writer_close(bk_h5_writer *w)
             rc = -1;
         w->s[i].dset = H5I_INVALID_HID;
     }
-    bk_h5_table *tables[2] = {&w->trans, &w->events};
-    for (int k = 0; k < 2; ++k) {
-        bk_h5_table *t = tables[k];
+    for (int k = 0; k < BK_N_TABLES; ++k) {
+        bk_h5_table *t = &w->tables[k];
         if (t->dset >= 0 && H5Dclose(t->dset) < 0)
             rc = -1;
         if (t->mem >= 0 && H5Tclose(t->mem) < 0)
@@ -265,8 +273,8 @@ void bk_h5_writer_free(bk_h5_writer *w)
         close(w->part_fd);
     for (int i = 0; i < BK_N_SERIES; ++i)
         free(w->s[i].buf);
-    free(w->trans.buf);
-    free(w->events.buf);
+    for (int k = 0; k < BK_N_TABLES; ++k)
+        free(w->tables[k].buf);
     free(w->path);
     free(w->part);
     free(w);
@@ -280,8 +288,8 @@ int bk_h5_writer_new(bk_h5_writer **out, const char *path, bk_error *err)
         return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
     w->file = H5I_INVALID_HID;
     w->part_fd = -1;
-    w->trans.dset = w->trans.mem = w->trans.packed = H5I_INVALID_HID;
-    w->events.dset = w->events.mem = w->events.packed = H5I_INVALID_HID;
+    for (int k = 0; k < BK_N_TABLES; ++k)
+        w->tables[k].dset = w->tables[k].mem = w->tables[k].packed = H5I_INVALID_HID;
     for (int i = 0; i < BK_N_SERIES; ++i)
         w->s[i].dset = H5I_INVALID_HID;
     w->last_commit = wall_seconds();
@@ -317,16 +325,16 @@ int bk_h5_writer_series(bk_h5_writer *w, int i, const bk_model *model)
     return s->buf ? 0 : -1;
 }
 
-int bk_h5_writer_table(bk_h5_table *table, int events)
+int bk_h5_writer_table(bk_h5_table *table, bk_h5_table_kind kind)
 {
-    table->record = events ? BK_EVENT_RECORD_BYTES : BK_TRANSITION_RECORD_BYTES;
-    table->capacity = events ? EVENT_BUFFER : TRANSITION_BUFFER;
+    table->record = bk_h5_tables[kind].record_bytes;
+    table->capacity = bk_h5_tables[kind].buffer;
     table->buffered = 0;
     table->buf = malloc(table->capacity * table->record);
     if (!table->buf)
         return -1;
-    table->mem = events ? bk_h5_event_type(BK_H5_RECORD_STRUCT) : bk_h5_transition_type(BK_H5_RECORD_STRUCT);
-    table->packed = events ? bk_h5_event_type(BK_H5_RECORD_PACKED) : bk_h5_transition_type(BK_H5_RECORD_PACKED);
+    table->mem = bk_h5_table_type(kind, BK_H5_RECORD_STRUCT);
+    table->packed = bk_h5_table_type(kind, BK_H5_RECORD_PACKED);
     return table->mem >= 0 && table->packed >= 0 ? 0 : -1;
 }
 
@@ -462,10 +470,9 @@ int bk_h5_writer_flush(bk_h5_writer *w, bk_error *err)
     for (int i = 0; rc == BK_OK && i < BK_N_SERIES; ++i)
         if (w->s[i].dset >= 0)
             rc = append_series(w, i, err);
-    if (rc == BK_OK)
-        rc = append_table(w, &w->trans, "transitions", err);
-    if (rc == BK_OK)
-        rc = append_table(w, &w->events, "events", err);
+    for (int k = 0; rc == BK_OK && k < BK_N_TABLES; ++k)
+        if (w->tables[k].dset >= 0)
+            rc = append_table(w, &w->tables[k], bk_h5_tables[k].name, err);
     if (rc != BK_OK)
         return rc;
     w->t_written = w->t_buffered;
@@ -553,16 +560,15 @@ static int sink_sample(void *self, const bk_sample *sample, bk_error *err)
     return rc == BK_OK ? maybe_commit(w, err) : rc;
 }
 
-static int buffer_record(bk_h5_writer *w, bk_h5_table *t, const char *name, const void *record,
-                         int events, bk_error *err)
+/* One record into table kind's buffer, appended when the buffer is full (maybe_commit:
+ * commit decides after the record, so a caller with several records passes commit = 0 for
+ * all but the last). */
+static int buffer_record(bk_h5_writer *w, bk_h5_table_kind kind, const void *record, int commit, bk_error *err)
 {
-    unsigned char *row = t->buf + t->buffered * t->record;
-    if (events)
-        bk_h5_pack_event(record, row);
-    else
-        bk_h5_pack_transition(record, row);
-    int rc = ++t->buffered == t->capacity ? append_table(w, t, name, err) : BK_OK;
-    return rc == BK_OK ? maybe_commit(w, err) : rc;
+    bk_h5_table *t = &w->tables[kind];
+    bk_h5_pack_record(kind, record, t->buf + t->buffered * t->record);
+    int rc = ++t->buffered == t->capacity ? append_table(w, t, bk_h5_tables[kind].name, err) : BK_OK;
+    return rc == BK_OK && commit ? maybe_commit(w, err) : rc;
 }
 
 static int sink_transition(void *self, const bk_transition *transition, bk_error *err)
@@ -574,10 +580,10 @@ static int sink_transition(void *self, const bk_transition *transition, bk_error
     if (transition->block < 0 || (size_t)transition->block >= w->n_blocks)
         return BK_FAIL(err, BK_ERR_INVALID, "%s: transition of block %d, allowed 0..%zu",
                        w->part, (int)transition->block, w->n_blocks - 1);
-    if (w->trans.dset < 0)
+    if (w->tables[BK_TABLE_TRANSITIONS].dset < 0)
         return BK_OK;
     w->trans_last_t = transition->t;
-    return buffer_record(w, &w->trans, "transitions", transition, 0, err);
+    return buffer_record(w, BK_TABLE_TRANSITIONS, transition, 1, err);
 }
 
 static int sink_event(void *self, const bk_event *event, bk_error *err)
@@ -585,9 +591,27 @@ static int sink_event(void *self, const bk_event *event, bk_error *err)
     bk_h5_writer *w = self;
     if (w->failed)
         return BK_FAIL(err, BK_ERR_HDF5, "%s: an earlier write failed; no more events accepted", w->part);
-    if (w->events.dset < 0)
+    if (w->tables[BK_TABLE_EVENTS].dset < 0)
         return BK_OK;
-    return buffer_record(w, &w->events, "events", event, 1, err);
+    return buffer_record(w, BK_TABLE_EVENTS, event, 1, err);
+}
+
+/* A rupture's three parts, its row last: a reader that finds the row finds its blocks and
+ * rate (a commit falls only after the whole rupture). */
+static int sink_rupture(void *self, const bk_rupture *rupture, const bk_rupture_block *blocks, size_t n_blocks,
+                        const bk_rupture_rate *rate, size_t n_rate, bk_error *err)
+{
+    bk_h5_writer *w = self;
+    if (w->failed)
+        return BK_FAIL(err, BK_ERR_HDF5, "%s: an earlier write failed; no more ruptures accepted", w->part);
+    if (w->tables[BK_TABLE_RUPTURES].dset < 0)
+        return BK_OK;
+    int rc = BK_OK;
+    for (size_t k = 0; rc == BK_OK && k < n_blocks; ++k)
+        rc = buffer_record(w, BK_TABLE_RUPTURE_BLOCKS, &blocks[k], 0, err);
+    for (size_t k = 0; rc == BK_OK && k < n_rate && w->tables[BK_TABLE_RUPTURE_RATE].dset >= 0; ++k)
+        rc = buffer_record(w, BK_TABLE_RUPTURE_RATE, &rate[k], 0, err);
+    return rc == BK_OK ? buffer_record(w, BK_TABLE_RUPTURES, rupture, 1, err) : rc;
 }
 
 /* Rows up to the checkpoint are flushed first, so the row counts it records are on disk. */
@@ -600,7 +624,7 @@ static int sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
     if (rc != BK_OK)
         return rc;
     bk_checkpoint_record rec = {w->cp_sequence + 1, (long long)w->rows,
-                                (long long)w->trans.written, w->trans_last_t};
+                                (long long)w->tables[BK_TABLE_TRANSITIONS].written, w->trans_last_t};
     rc = bk_h5_write_checkpoint(w->file, w->part, w->cp_slot, cp, &rec, err);
     if (rc != BK_OK) {
         w->failed = 1;
@@ -613,7 +637,7 @@ static int sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
 
 bk_sink bk_h5_writer_sink(bk_h5_writer *writer)
 {
-    bk_sink sink = {writer, sink_sample, sink_transition, sink_checkpoint, sink_event};
+    bk_sink sink = {writer, sink_sample, sink_transition, sink_checkpoint, sink_event, sink_rupture};
     return sink;
 }
 
