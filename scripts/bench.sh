@@ -5,7 +5,8 @@
 #   results.tsv, scaling.tsv, scaling_slopes.tsv (scripts/bench_scaling.sh), long_run.tsv,
 #   machine.txt, tables.md, wp_<case>.png (error vs CPU, log-log), scaling.png,
 #   scaling_memory.png, scaling_run_length.tsv and .png, and output_writer.tsv,
-#   output_rhs.tsv, output.md (scripts/bench_output.sh: what dense output costs)
+#   output_rhs.tsv, output.md (scripts/bench_output.sh: what dense output costs),
+#   ruptures_bench.tsv (scripts/bench_ruptures.sh: the rupture catalog of a 10^6-block chain)
 # Takes about 30 minutes (the scaling part alone 19) on the machine in bench/machine.txt;
 # `scripts/bench.sh --quick` is a smoke run into a temporary directory, `--plot-only`
 # redraws the PNGs and tables from the TSVs in bench/.
@@ -35,6 +36,7 @@ if [ $plot_only = 0 ]; then
     scripts/bench_scaling.sh $([ ${#quick[@]} -gt 0 ] && echo --quick) "$out"
     "$bench" --long-run "${quick[@]}" --out "$out/long_run.tsv"
     scripts/bench_output.sh $([ ${#quick[@]} -gt 0 ] && echo --quick) "$out"
+    scripts/bench_ruptures.sh $([ ${#quick[@]} -gt 0 ] && echo --quick) "$out"
 fi
 if [ $plot_only = 1 ]; then scripts/bench_scaling.sh --plot-only "$out"; fi
 

@@ -2,7 +2,7 @@
 # What plot scripts share beyond lib.sh (sourced here: a plot script sources only this):
 # plot_setup and plot_panels for the paper figures (plot_cof.sh, plot_kinematics.sh,
 # plot_fig2.sh); plot_file_option and plot_file_setup for the figures of one output file
-# (plot_mfd.sh, plot_slip_map.sh).  Sourced, not run.
+# (plot_mfd.sh, plot_slip_map.sh, plot_ruptures.sh).  Sourced, not run.
 
 # shellcheck source=lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"

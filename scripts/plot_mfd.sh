@@ -1,32 +1,48 @@
 #!/usr/bin/env bash
-# The event catalog /events of a run, as two figures:
-#   OUTDIR/<stem>_mfd.<fmt>        magnitude-frequency distribution: incremental (points) and
-#                                  cumulative (line and points) counts per magnitude bin on a
-#                                  log scale, the fitted Gutenberg-Richter law
-#                                  log10 N = a - b M from Mc up, b and its error, Mc marked;
-#   OUTDIR/<stem>_spacetime.<fmt>  every event's extent (blocks left..right) at its start
-#                                  time, coloured by magnitude; an event that wraps past
-#                                  block 0 on a ring (left > right) is drawn as two segments.
-# The statistics are `bksim stats FILE` (complete events only; Mc by maximum curvature + 0.2,
-# bins of 0.1); the events are `bksim export FILE --events` (every row, running ones too).
-# <stem> is FILE's name without .h5 (and .part); OUTDIR defaults to FILE's directory.
-# Optional XRANGE=lo:hi (s) zooms the space-time plot in time.
-# usage: plot_mfd.sh [--format png|pdf|svg] [-o OUTDIR] FILE.h5
+# A run's earthquake catalog as two figures: the rupture catalog /ruptures (connected slip
+# episodes, README "Ruptures"; the default) or, with --table events, the time-window catalog
+# /events (maximal intervals during which some block slips):
+#   OUTDIR/<stem>_ruptures_mfd.<fmt>  magnitude-frequency distribution: incremental (points)
+#       (events: <stem>_mfd.<fmt>)    and cumulative (line and points) counts per magnitude
+#                                     bin on a log scale, the fitted Gutenberg-Richter law
+#                                     log10 N = a - b M from Mc up, b and its error, Mc marked;
+#   OUTDIR/<stem>_ruptures_spacetime.<fmt>  every rupture's (event's) extent (blocks
+#       (events: <stem>_spacetime.<fmt>)    left..right) at its start time, coloured by
+#                                           magnitude; one that wraps past block 0 on a ring
+#                                           (left > right) is drawn as two segments.
+# The statistics are `bksim stats FILE --table TABLE` (complete rows only; Mc by maximum
+# curvature + 0.2, bins of 0.1); the rows are `bksim export FILE --table TABLE` (every row,
+# running ones too).  A file without the table is an error (an older file has no /ruptures:
+# give --table events).  <stem> is FILE's name without .h5 (and .part); OUTDIR defaults to
+# FILE's directory.  Optional XRANGE=lo:hi (s) zooms the space-time plot in time.
+# usage: plot_mfd.sh [--format png|pdf|svg] [-o OUTDIR] [--table ruptures|events] FILE.h5
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/plot_lib.sh"
+table=ruptures
 while [ $# -gt 0 ]; do
-    plot_file_option "$@"
-    shift "$PLOT_SHIFT"
+    case $1 in
+        --table) bk_need_value $# "$1"; table=$2; shift 2 ;;
+        --table=*) table=${1#--table=}; shift ;;
+        *) plot_file_option "$@"; shift "$PLOT_SHIFT" ;;
+    esac
 done
+case $table in ruptures|events) ;; *) bk_usage "--table must be ruptures or events, got '$table'" ;; esac
 plot_file_setup
-mfd_out="$outdir/${stem}_mfd.$format"
-st_out="$outdir/${stem}_spacetime.$format"
+# The words and file names of the catalog.
+if [ "$table" = ruptures ]; then
+    rows_word=ruptures prefix=${stem}_ruptures export_args=(--table ruptures) mfd_of=" of the ruptures"
+else
+    rows_word=events prefix=$stem export_args=(--events) mfd_of=""
+fi
+mfd_out="$outdir/${prefix}_mfd.$format"
+st_out="$outdir/${prefix}_spacetime.$format"
 
-"$bksim" export "$file" --events > "$tmp/events.tsv" 2> "$tmp/err" ||
+no_table_hint=""
+[ "$table" = events ] || no_table_hint=" (--table events plots the time-window catalog /events)"
+"$bksim" export "$file" "${export_args[@]}" > "$tmp/events.tsv" 2> "$tmp/err" ||
+    bk_fail 1 "$(cat "$tmp/err")$no_table_hint"
+"$bksim" stats "$file" --table "$table" --json --tsv "$tmp/stats" > "$tmp/stats.json" 2> "$tmp/err" ||
     bk_fail 1 "$(cat "$tmp/err")"
-"$bksim" stats "$file" --json --tsv "$tmp/stats" > "$tmp/stats.json" 2> "$tmp/err" ||
-    bk_fail 1 "$(cat "$tmp/err")"
-
 # A top-level value of the JSON report (the first occurrence of the key): a number, or
 # null when bksim could not estimate it; json_note gives a *_note string.
 json() { grep -o "\"$1\": [^,}]*" "$tmp/stats.json" | head -n 1 | sed 's/^[^:]*: //'; }
@@ -35,7 +51,7 @@ n_rows=$(json n_rows); n_events=$(json n_events)
 n_incomplete=$(json n_incomplete); n_nonfinite=$(json n_nonfinite)
 n_mc=$(json n_above_mc); mc=$(json mc); b=$(json b_value); b_err=$(json b_value_error); a=$(json a_value)
 dm=$(json bin); m_max=$(json magnitude_max)
-[ "$n_rows" -gt 0 ] || bk_fail 1 "$file: /events is empty: nothing to plot"
+[ "$n_rows" -gt 0 ] || bk_fail 1 "$file: /$table is empty: nothing to plot"
 
 # The chain's length (bksim info; its exit status says whether the run finished, which
 # does not matter here), else the largest block an event reached.
@@ -52,11 +68,11 @@ num() { LC_ALL=C printf "%.${2}${3:-f}" "$1" | sed 's/^-/−/'; }
 left_out=""
 [ "$n_incomplete" -eq 0 ] || left_out="$n_incomplete still running at the end"
 [ "$n_nonfinite" -eq 0 ] || left_out="${left_out:+$left_out, }$n_nonfinite of zero potency (M = −∞)"
-subtitle="$n_events complete events in bins of ΔM = $dm${left_out:+; left out: $left_out}"
+subtitle="$n_events complete $rows_word in bins of ΔM = $dm${left_out:+; left out: $left_out}"
 if [ "$b" != null ]; then
     b_err_text=""
     [ "$b_err" = null ] || b_err_text=" ± $(num "$b_err" 3)"
-    fit_title="Gutenberg–Richter fit for M ≥ Mc: log₁₀ N = a − b M, b = $(num "$b" 3)${b_err_text}, a = $(num "$a" 3) ($n_mc events)"
+    fit_title="Gutenberg–Richter fit for M ≥ Mc: log₁₀ N = a − b M, b = $(num "$b" 3)${b_err_text}, a = $(num "$a" 3) ($n_mc $rows_word)"
     fit_plot=", [x=$mc:$m_max + $dm/2] 10**($a - $b*x) with lines lw 2.5 lc rgb '#d62728' title '$fit_title'"
 else
     fit_plot=", NaN with lines lw 2.5 lc rgb '#d62728' title 'no Gutenberg–Richter fit: $(bk_gp_quote "$(json_note b_value_note)")'"
@@ -78,10 +94,10 @@ gnuplot <<GP || bk_fail 1 "gnuplot failed drawing $mfd_out"
 set encoding utf8
 set terminal $terminal
 set output '$(bk_gp_quote "$mfd_out")'
-set title '$(bk_gp_quote "$stem"): magnitude-frequency distribution' . "\n" . '$(bk_gp_quote "$subtitle")'
+set title '$(bk_gp_quote "$stem"): magnitude-frequency distribution$mfd_of' . "\n" . '$(bk_gp_quote "$subtitle")'
 set grid lc rgb '#c0c0c0' lw 1 dt 3
 set xlabel 'magnitude M'
-set ylabel 'number of events N'
+set ylabel 'number of $rows_word N'
 set xrange [$mfd_x]
 set logscale y
 set format y '%g'
@@ -94,7 +110,7 @@ plot '$tmp/stats/mfd.tsv' using 1:(\$3 > 0 ? \$3 : NaN) with linespoints pt 7 ps
      $fit_plot $mc_plot
 GP
 else
-    bk_warn "$file: no complete event with a finite magnitude: no $mfd_out"
+    bk_warn "$file: no complete row of /$table with a finite magnitude: no $mfd_out"
 fi
 
 # ------------------------------------------------------------- (b) space-time ---
@@ -127,9 +143,9 @@ gnuplot <<GP || bk_fail 1 "gnuplot failed drawing $st_out"
 set encoding utf8
 set terminal $terminal
 set output '$(bk_gp_quote "$st_out")'
-set title '$(bk_gp_quote "$stem"): events in space and time' . "\n" . \
-          '$n_rows events$wrap_note; a segment spans blocks left..right at t_start'
-set xlabel 'event start time t_start [s]'
+set title '$(bk_gp_quote "$stem"): $rows_word in space and time' . "\n" . \
+          '$n_rows $rows_word$wrap_note; a segment spans blocks left..right at t_start'
+set xlabel '${rows_word%s} start time t_start [s]'
 set ylabel 'block'
 set xrange [${XRANGE:-$t_range}]
 set yrange [-0.5 : $n_blocks - 0.5]

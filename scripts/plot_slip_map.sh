@@ -1,38 +1,63 @@
 #!/usr/bin/env bash
-# One event's slip over a 2D lattice, as OUTDIR/<stem>_slip_map_<K>.<fmt>: a map of rows x
-# cols cells (block i at row i / cols, column i % cols; row 0 on top; a chain is one row),
-# each coloured by how far block i slipped in the event (m).  With /transitions (the
-# default) that is exact: x at the block's last transition in the event minus x at its
-# first.  Without, or for an event still running at the end, it is x in the first sample
-# row at or after t_end (else the last row) minus x in the last one at or before t_start,
-# which also counts whatever else moved between those rows.  The epicentre (first_block) is a point, the event's
-# bounding box (left..right) a rectangle, in pieces when it wraps round a periodic edge.
-# K is the 0-based row of /events (`bksim export FILE --events`); by default, or with
-# --largest, the event of largest potency.  <stem> is FILE's name without .h5 (and .part);
-# OUTDIR defaults to FILE's directory.
-# usage: plot_slip_map.sh [--format png|pdf|svg] [-o OUTDIR] [--event K | --largest] FILE.h5
+# One rupture's (or event's) slip over a 2D lattice, as a map of rows x cols cells (block i
+# at row i / cols, column i % cols; row 0 on top; a chain is one row), each coloured by how
+# far block i slipped (m):
+#   OUTDIR/<stem>_rupture_<K>_slip_map.<fmt>  row K of the rupture catalog /ruptures (the
+#       default; --rupture K): the slip of each of its blocks from /rupture_blocks, x at its
+#       last stop minus x at its first onset in the rupture: exact, whatever the file keeps;
+#   OUTDIR/<stem>_slip_map_<K>.<fmt>  row K of the time-window catalog /events (--table
+#       events, or --event K).  With /transitions (the default) that is exact: x at the
+#       block's last transition in the event minus x at its first.  Without, or for an
+#       event still running at the end, it is x in the first sample row at or after t_end
+#       (else the last row) minus x in the last one at or before t_start, which also counts
+#       whatever else moved between those rows.
+# The epicentre (first_block) is a point, the bounding box (left..right) a rectangle, in
+# pieces when it wraps round a periodic edge.  K is the 0-based row (`bksim export FILE
+# --table ruptures`, or --events); by default, or with --largest, the row of largest
+# potency.  A file without the table is an error (an older file has no /ruptures: give
+# --table events).  <stem> is FILE's name without .h5 (and .part); OUTDIR defaults to
+# FILE's directory.
+# usage: plot_slip_map.sh [--format png|pdf|svg] [-o OUTDIR] [--table ruptures|events]
+#                         [--rupture K | --event K | --largest] FILE.h5
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/plot_lib.sh"
-event=""
+event="" table="" row_option=""
 while [ $# -gt 0 ]; do
     case $1 in
-        --event) bk_need_value $# "$1"; event=$2; shift 2 ;;
-        --event=*) event=${1#--event=}; shift ;;
+        --rupture|--event) bk_need_value $# "$1"; event=$2; row_option=$1; shift 2 ;;
+        --rupture=*|--event=*) event=${1#*=}; row_option=${1%%=*}; shift ;;
         --largest) event=""; shift ;;
+        --table) bk_need_value $# "$1"; table=$2; shift 2 ;;
+        --table=*) table=${1#--table=}; shift ;;
         *) plot_file_option "$@"; shift "$PLOT_SHIFT" ;;
     esac
 done
-[ -z "$event" ] || bk_check_whole --event "$event" "an event row" 0
+case $table in ruptures|events|"") ;; *) bk_usage "--table must be ruptures or events, got '$table'" ;; esac
+# --rupture K reads /ruptures, --event K /events; either with a --table that names the other
+# is a usage error.
+case $row_option in
+    --rupture) [ "$table" != events ] || bk_usage "--rupture K reads /ruptures: not with --table events (give --event K)" ;;
+    --event) [ "$table" != ruptures ] || bk_usage "--event K reads /events: not with --table ruptures (give --rupture K)"
+             table=events ;;
+esac
+table=${table:-ruptures}
+[ -z "$event" ] || bk_check_whole "${row_option}" "$event" "a row of /$table" 0
 plot_file_setup
 partial=""
 bk_at_exit '[ -z "$partial" ] || rm -f "$partial"'
-"$bksim" export "$file" --events > "$tmp/events.tsv" 2> "$tmp/err" ||
-    bk_fail 1 "$(cat "$tmp/err")"
+if [ "$table" = ruptures ]; then
+    row_word=rupture export_args=(--table ruptures)
+    no_table_hint=" (--table events maps a row of the time-window catalog /events)"
+else
+    row_word=event export_args=(--events) no_table_hint=""
+fi
+"$bksim" export "$file" "${export_args[@]}" > "$tmp/events.tsv" 2> "$tmp/err" ||
+    bk_fail 1 "$(cat "$tmp/err")$no_table_hint"
 
-# The event: row K, or the largest finite potency (the first of equals; row 0 if none is
-# finite).  Its fields, tab-separated, go to the shell in one read.
+# The row: K, or the largest finite potency (the first of equals; row 0 if none is finite).
+# Its fields, tab-separated, go to the shell in one read.
 n_events=$(awk '!/^#/' "$tmp/events.tsv" | wc -l)
-[ "$n_events" -gt 0 ] || bk_fail 1 "$file: /events is empty: no event to map"
+[ "$n_events" -gt 0 ] || bk_fail 1 "$file: /$table is empty: no $row_word to map"
 if [ -z "$event" ]; then
     event=$(awk -F'\t' '/^#/ {next}
         {k = n++; p = $8 + 0}
@@ -42,12 +67,14 @@ if [ -z "$event" ]; then
 else
     event=$(echo "$event" | sed 's/^0*//; s/^$/0/')
     if [ ${#event} -gt 15 ] || [ "$event" -ge "$n_events" ]; then
-        bk_fail 1 "$file: --event $event out of range: /events has $n_events rows (0..$((n_events - 1)))"
+        bk_fail 1 "$file: $row_option $event out of range: /$table has $n_events rows (0..$((n_events - 1)))"
     fi
     what=""
 fi
+# /events ends with complete; /ruptures has duration and the front speeds before it.
 IFS=$'\t' read -r t_start t_end first_block ev_blocks left right _ _ magnitude _ _ complete < <(
-    awk -F'\t' -v k="$event" '!/^#/ && n++ == k' "$tmp/events.tsv")
+    awk -F'\t' -v k="$event" -v ruptures="$([ "$table" = ruptures ] && echo 1 || echo 0)" '
+        !/^#/ && n++ == k { if (ruptures) $12 = $15; NF = 12; print }' OFS='\t' "$tmp/events.tsv")
 
 # The lattice's shape (bksim info; its exit status says whether the run finished, which
 # does not matter here): "lattice R x C blocks ...", or no such line for a chain, one row.
@@ -62,16 +89,34 @@ shape=$(awk '$1 == "lattice" {
 read -r rows cols <<<"${shape:-1 $n_blocks}"
 [ "$((rows * cols))" -eq "$n_blocks" ] || bk_fail 1 "$file: a $rows x $cols lattice of $n_blocks blocks"
 
+# A rupture's slip is exact from /rupture_blocks: each of its blocks' x at its last stop
+# minus x at its first onset in the rupture.
+if [ "$table" = ruptures ]; then
+    "$bksim" export "$file" --table rupture_blocks > "$tmp/blocks.tsv" 2> "$tmp/err" ||
+        bk_fail 1 "$(cat "$tmp/err")"
+    awk -F'\t' -v k="$event" '!/^#/ && $1 == k' "$tmp/blocks.tsv" > "$tmp/one.tsv"
+    [ -s "$tmp/one.tsv" ] || bk_fail 1 "$file: /rupture_blocks has no row of rupture $event"
+fi
 # A finished event's slip is exact from /transitions, where the run kept them: a block is
 # stuck between its episodes, so x at its last transition in the event minus x at its first
 # is all it slipped, and nothing else that moved between two sample rows counts.  They come
-# as two rows in the export's form (t_start, then t_end), so the map below takes either.
+# as two rows in the export's form (t_start, then t_end), so the map below takes either; so
+# do a rupture's blocks (x = 0 at t_start, x = its slip at t_end).
 from_transitions=0
-if [ "$complete" = 1 ] &&
+if [ "$table" = events ] && [ "$complete" = 1 ] &&
    awk '$1 == "transitions" && $2 ~ /^[0-9]+$/ && $2 > 0 {found = 1} END {exit !found}' <<<"$info"; then
     from_transitions=1
 fi
 samples() {
+    if [ "$table" = ruptures ]; then
+        awk -F'\t' -v ts="$t_start" -v te="$t_end" -v n="$n_blocks" '
+            { slip[$2] = $5 }
+            END {
+                printf "%s", ts; for (i = 0; i < n; i++) printf " 0"; print ""
+                printf "%s", te; for (i = 0; i < n; i++) printf " %.17g", (i in slip) ? slip[i] : 0; print ""
+            }' "$tmp/one.tsv"
+        return
+    fi
     if [ "$from_transitions" = 0 ]; then
         "$bksim" export "$file" --datasets time,x
         return
@@ -167,19 +212,23 @@ fi
 epi_r=$((first_block / cols)); epi_c=$((first_block % cols))
 
 running=""; [ "$complete" = 1 ] || running=" (still running at the end)"
-title1="$stem: event $event (of 0..$((n_events - 1))$what), t = $(g "$t_start")..$(g "$t_end") s$running"
+title1="$stem: $row_word $event (of 0..$((n_events - 1))$what), t = $(g "$t_start")..$(g "$t_end") s$running"
 blocks_word=blocks; [ "$ev_blocks" != 1 ] || blocks_word=block
 title2="$ev_blocks $blocks_word, M = $(g "$magnitude" 4); slip from the sample at t = $(g "$t_before") s to the one at t = $(g "$t_after") s"
 [ "$from_transitions" = 0 ] ||
     title2="$ev_blocks $blocks_word, M = $(g "$magnitude" 4); slip from each block's first to its last transition in the event"
+[ "$table" = events ] ||
+    title2="$ev_blocks $blocks_word, M = $(g "$magnitude" 4); slip of each block, first onset to last stop (/rupture_blocks)"
 # Square cells unless the lattice is long and thin (a chain): then the cells fill the frame.
 ratio="set size ratio -1"
 if [ $((rows * 4)) -lt "$cols" ] || [ $((cols * 4)) -lt "$rows" ]; then ratio="set size noratio"; fi
 tics() { if [ "$1" -le 16 ]; then echo "set $2tics 1"; else echo "set $2tics out; set m$2tics"; fi; }
 
-out="$outdir/${stem}_slip_map_$event.$format"
+out_name=${stem}_slip_map_$event
+[ "$table" = events ] || out_name=${stem}_rupture_${event}_slip_map
+out="$outdir/$out_name.$format"
 # Drawn to a hidden file beside the figure, renamed when gnuplot succeeded.
-partial=$(mktemp "$outdir/.${stem}_slip_map_$event.XXXXXX") ||
+partial=$(mktemp "$outdir/.$out_name.XXXXXX") ||
     bk_fail 1 "$outdir: cannot write there"
 gnuplot <<GP 2> "$tmp/gp.err" || bk_fail 1 "gnuplot failed drawing $out: $(cat "$tmp/gp.err")"
 set encoding utf8
@@ -195,7 +244,7 @@ $( [ "$rows" -gt 1 ] || echo "set ytics (0)")
 set xlabel 'column (block i % $cols)'
 set ylabel 'row (block i / $cols)'
 set cbrange [$cb_range]
-set cblabel 'slip during the event [m]'
+set cblabel 'slip during the $row_word [m]'
 # Room on the right for the colour box's label.
 set rmargin 18
 set palette defined (0 '#ffffe5', 0.15 '#fff7bc', 0.3 '#fee391', 0.45 '#fec44f', 0.6 '#fe9929', 0.75 '#ec7014', 0.88 '#cc4c02', 1 '#662506')

@@ -212,8 +212,11 @@ int bk_run_ruptures_island_step(run_ctx *ctx, run_island *isl)
     for (size_t k = 0; k < island->n_active; ++k) {
         size_t i = island->active[k];
         double v1 = y[scene->slot[i] + 1], a1 = bk_run_speed_rate(isl, i, hi, y);
-        if (bk_ruptures_slipping(ctx->ruptures, i))
+        if (bk_ruptures_slipping(ctx->ruptures, i)) {
             steps[n++] = (block_step){i, v1, a1, NAN, NAN};
+            /* Nothing before the step's start can be taken back (a restart falls inside it). */
+            bk_ruptures_settle(ctx->ruptures, i, lo);
+        }
         else {
             ctx->rupture_v[i] = v1;
             ctx->rupture_a[i] = a1;

@@ -6,7 +6,14 @@
  * an open rupture, which is all a new onset needs to find what it links to: the episodes of
  * the block itself and of its neighbours that still run, or stopped at this very instant.
  * Every figure of a completed rupture is computed from its episodes sorted by (block, onset),
- * so the result does not depend on the order of merges or on a checkpoint in between. */
+ * so the result does not depend on the order of merges or on a checkpoint in between.
+ *
+ * The rate.  Each episode keeps its block's speed samples as a trace (piecewise linear in
+ * time); a rupture's rate is the sum of its traces on the union of their sample times.  So
+ * that a long rupture does not hold every block's every sample until it completes, samples
+ * the run has settled (bk_ruptures_settle: no restart can drop them any more) are folded into
+ * the rupture's own summed trace, its rate so far, once the samples held pass a bound that
+ * doubles with them: memory follows the rate's rows, not blocks times steps. */
 #include "bksim/rupture.h"
 
 #include <math.h>
@@ -18,8 +25,21 @@
 #include "extent.h"
 
 /* Checkpoint values: a format tag, then the counts (see bk_ruptures_save). */
-#define SAVE_FORMAT 1.0
+#define SAVE_FORMAT 2.0
 #define NONE (-1)
+
+/* A piecewise-linear function of time held as (t, value) samples, which counts only at
+ * times in (valid_after, until]: what is left of an episode's speeds after a fold, or the
+ * summed rate of a rupture absorbed by another. */
+typedef struct trace {
+    double *samples;         /* per point: (t, value), or for a sum of traces (t, value from the
+                                left, value, value to the right): a sum jumps where one of its
+                                traces starts or ends */
+    size_t n, capacity;      /* points; capacity in doubles */
+    double valid_after, until;
+    int32_t next;            /* in a rupture's list of absorbed rates, or the free list */
+    int stride;              /* doubles per point: 2, or 4 for a sum */
+} trace;
 
 typedef struct episode {
     int32_t block;
@@ -29,9 +49,10 @@ typedef struct episode {
     double t_onset, t_stop;  /* s */
     double x_onset, x_stop;  /* m */
     double f_onset, f_stop;  /* N */
-    double peak;             /* m/s, the largest sampled |v| */
-    double *samples;         /* (t, |v|) pairs in time order */
-    size_t n_samples, capacity;
+    double peak;             /* m/s, the largest sampled |v|, folded samples included */
+    double peak_folded;      /* m/s, the largest of the samples folded away */
+    double settled;          /* s: samples up to here are final */
+    trace speed;             /* its |v| samples (until = +inf) */
 } episode;
 
 typedef struct node {
@@ -43,6 +64,10 @@ typedef struct node {
     int32_t n_open;          /* a root's episodes still running */
     int pending;             /* a root with nothing running since t_now */
     int live;
+    trace rate;              /* a root's summed rate up to rate.until (valid_after = -inf) */
+    int32_t absorbed;        /* a root's list of traces: rates of ruptures merged into it */
+    long held;               /* samples its episodes and absorbed traces hold */
+    long fold_at;            /* fold once held passes this */
 } node;
 
 struct bk_ruptures {
@@ -59,6 +84,9 @@ struct bk_ruptures {
     node *nodes;
     size_t n_nodes_pool, nodes_capacity;
     int32_t free_node;
+    trace *traces;           /* absorbed rates */
+    size_t n_traces_pool, traces_capacity;
+    int32_t free_trace;
     int32_t *pending;        /* roots that went pending at t_now (some may have merged since) */
     size_t n_pending, pending_capacity;
     double t_now;            /* s, the time of the last transition */
@@ -70,8 +98,8 @@ struct bk_ruptures {
     size_t block_list_capacity, lines_capacity;
     bk_rupture_block *blocks_out;
     size_t blocks_out_capacity;
-    double *grid;
-    size_t grid_capacity;
+    double *grid, *values;
+    size_t grid_capacity, values_capacity;
     bk_rupture_rate *rate_out;
     size_t rate_out_capacity;
 };
@@ -94,7 +122,7 @@ bk_ruptures *bk_ruptures_create(size_t rows, size_t cols, int ring_rows, int rin
     b->keep_rate = keep_rate;
     b->emit = emit;
     b->emit_user = emit_user;
-    b->free_episode = b->free_node = NONE;
+    b->free_episode = b->free_node = b->free_trace = NONE;
     b->t_now = -INFINITY;
     b->latest = malloc(b->n * sizeof *b->latest);
     if (!b->latest) {
@@ -111,16 +139,22 @@ void bk_ruptures_free(bk_ruptures *b)
     if (!b)
         return;
     for (size_t e = 0; e < b->n_episodes_pool; ++e)
-        free(b->episodes[e].samples);
+        free(b->episodes[e].speed.samples);
+    for (size_t r = 0; r < b->n_nodes_pool; ++r)
+        free(b->nodes[r].rate.samples);
+    for (size_t k = 0; k < b->n_traces_pool; ++k)
+        free(b->traces[k].samples);
     free(b->latest);
     free(b->episodes);
     free(b->nodes);
+    free(b->traces);
     free(b->pending);
     free(b->order);
     free(b->block_list);
     free(b->lines);
     free(b->blocks_out);
     free(b->grid);
+    free(b->values);
     free(b->rate_out);
     free(b);
 }
@@ -141,17 +175,52 @@ static int32_t new_episode(bk_ruptures *b)
             return NONE;
         b->episodes = grown;
         e = (int32_t)b->n_episodes_pool++;
-        b->episodes[e].samples = NULL;
-        b->episodes[e].capacity = 0;
+        b->episodes[e].speed = (trace){0};
     }
     episode *ep = &b->episodes[e];
-    double *samples = ep->samples;
-    size_t capacity = ep->capacity;
+    trace kept = ep->speed; /* its buffer, for reuse */
     memset(ep, 0, sizeof *ep);
-    ep->samples = samples; /* kept for reuse */
-    ep->capacity = capacity;
+    ep->speed = (trace){kept.samples, 0, kept.capacity, -INFINITY, INFINITY, NONE, 2};
     ep->next = ep->node = NONE;
     return e;
+}
+
+/* Keep a buffer for the next user unless it grew long. */
+static void trace_clear(trace *tr)
+{
+    if (tr->capacity > 256) {
+        free(tr->samples);
+        tr->samples = NULL;
+        tr->capacity = 0;
+    }
+    tr->n = 0;
+}
+
+static int32_t new_trace(bk_ruptures *b)
+{
+    int32_t k = b->free_trace;
+    if (k != NONE) {
+        b->free_trace = b->traces[k].next;
+    } else {
+        if (b->n_traces_pool >= (size_t)INT32_MAX)
+            return NONE;
+        trace *grown = bk_grow_array(b->traces, &b->traces_capacity, b->n_traces_pool + 1, sizeof *grown, 16);
+        if (!grown)
+            return NONE;
+        b->traces = grown;
+        k = (int32_t)b->n_traces_pool++;
+        b->traces[k] = (trace){0};
+    }
+    trace *tr = &b->traces[k];
+    *tr = (trace){tr->samples, 0, tr->capacity, -INFINITY, INFINITY, NONE, 4};
+    return k;
+}
+
+static void release_trace(bk_ruptures *b, int32_t k)
+{
+    trace_clear(&b->traces[k]);
+    b->traces[k].next = b->free_trace;
+    b->free_trace = k;
 }
 
 static void release_episode(bk_ruptures *b, int32_t e)
@@ -159,13 +228,7 @@ static void release_episode(bk_ruptures *b, int32_t e)
     episode *ep = &b->episodes[e];
     if (b->latest[ep->block] == e)
         b->latest[ep->block] = NONE;
-    /* A long episode's samples are not kept for the next one. */
-    if (ep->capacity > 256) {
-        free(ep->samples);
-        ep->samples = NULL;
-        ep->capacity = 0;
-    }
-    ep->n_samples = 0;
+    trace_clear(&ep->speed);
     ep->next = b->free_episode;
     b->free_episode = e;
 }
@@ -183,9 +246,13 @@ static int32_t new_node(bk_ruptures *b)
             return NONE;
         b->nodes = grown;
         r = (int32_t)b->n_nodes_pool++;
+        b->nodes[r].rate = (trace){0};
     }
+    trace rate = b->nodes[r].rate; /* its buffer, for reuse */
     b->nodes[r] = (node){.parent = NONE, .head = NONE, .tail = NONE, .merged = NONE,
-                         .merged_tail = NONE, .next_node = NONE, .live = 1};
+                         .merged_tail = NONE, .next_node = NONE, .live = 1, .absorbed = NONE,
+                         .fold_at = 256};
+    b->nodes[r].rate = (trace){rate.samples, 0, rate.capacity, -INFINITY, -INFINITY, NONE, 4};
     return r;
 }
 
@@ -214,9 +281,23 @@ static void append_episode(bk_ruptures *b, int32_t root, int32_t e)
     r->tail = e;
 }
 
-/* Root `from` joins root `into`: its episodes, its merged nodes and itself. */
-static void merge(bk_ruptures *b, int32_t into, int32_t from)
+/* Root `from` joins root `into`: its episodes, its merged nodes, itself, and its rate so far
+ * (an absorbed trace of into's, summed in at the next fold). */
+static int merge(bk_ruptures *b, int32_t into, int32_t from)
 {
+    if (b->nodes[from].rate.n > 0) {
+        int32_t k = new_trace(b); /* may move b->traces, never b->nodes */
+        if (k == NONE)
+            return BK_ERR_NOMEM;
+        trace *tr = &b->traces[k];
+        trace spare = *tr;
+        *tr = b->nodes[from].rate; /* the buffer moves; from keeps the spare */
+        tr->valid_after = -INFINITY;
+        tr->next = b->nodes[into].absorbed;
+        b->nodes[into].absorbed = k;
+        b->nodes[into].held += (long)tr->n;
+        b->nodes[from].rate = (trace){spare.samples, 0, spare.capacity, -INFINITY, -INFINITY, NONE, 4};
+    }
     node *a = &b->nodes[into], *c = &b->nodes[from];
     if (c->head != NONE) {
         if (a->tail == NONE)
@@ -226,6 +307,14 @@ static void merge(bk_ruptures *b, int32_t into, int32_t from)
         a->tail = c->tail;
     }
     a->n_open += c->n_open;
+    a->held += c->held;
+    /* Its absorbed traces go on into's list. */
+    while (c->absorbed != NONE) {
+        int32_t k = c->absorbed;
+        c->absorbed = b->traces[k].next;
+        b->traces[k].next = a->absorbed;
+        a->absorbed = k;
+    }
     /* from and the nodes merged into it go on into's list: [from, from's list..., into's]. */
     int32_t tail = c->merged_tail != NONE ? c->merged_tail : from;
     c->next_node = c->merged;
@@ -237,35 +326,284 @@ static void merge(bk_ruptures *b, int32_t into, int32_t from)
     c->parent = into;
     c->head = c->tail = NONE;
     c->n_open = 0;
+    c->held = 0;
     c->pending = 0;
+    return BK_OK;
 }
 
-static int push_sample(episode *ep, double t, double speed)
+/* ------------------------------------------------------------------ folding --- */
+
+static int compare_double(const void *a, const void *c)
 {
-    int dropped = 0;
-    while (ep->n_samples > 0 && ep->samples[2 * (ep->n_samples - 1)] > t) {
-        ep->n_samples--;
-        dropped = 1;
-    }
-    if (ep->n_samples > 0 && ep->samples[2 * (ep->n_samples - 1)] == t) {
-        ep->samples[2 * (ep->n_samples - 1) + 1] = speed;
+    double x = *(const double *)a, y = *(const double *)c;
+    return (x > y) - (x < y);
+}
+
+/* Time of point q. */
+static inline double point_t(const trace *tr, size_t q)
+{
+    return tr->samples[(size_t)tr->stride * q];
+}
+
+/* The trace's value at t (*value) and its limits from the left and to the right: linear
+ * between its points, 0 outside them and outside (valid_after, until]; a trace jumps from 0
+ * at its first point, and back to 0 after its last if it ends there (ends: an episode that
+ * stopped; a sum always ends at until).  *cursor: a point index at or before t's, advanced as
+ * t grows. */
+static void trace_at(const trace *tr, double t, size_t *cursor, int ends, double *left, double *value,
+                     double *right)
+{
+    *left = *value = *right = 0.0;
+    if (tr->n == 0 || t < tr->valid_after || t > tr->until || t < point_t(tr, 0) || t > point_t(tr, tr->n - 1))
+        return;
+    size_t q = *cursor;
+    while (q + 1 < tr->n && point_t(tr, q + 1) <= t)
+        q++;
+    *cursor = q;
+    const double *p = tr->samples + (size_t)tr->stride * q;
+    int sum = tr->stride == 4;
+    if (p[0] == t) {
+        *value = sum ? p[2] : p[1];
+        *left = q == 0 ? 0.0 : p[1];
+        /* A sum ends at until: what follows is another trace's. */
+        *right = (q + 1 == tr->n && ends) || t >= tr->until ? 0.0 : sum ? p[3] : p[1];
     } else {
-        double *grown = bk_grow_array(ep->samples, &ep->capacity, 2 * (ep->n_samples + 1), sizeof *grown, 8);
+        const double *next = p + tr->stride;
+        double from = sum ? p[3] : p[1];
+        *left = *value = *right = from + (t - p[0]) / (next[0] - p[0]) * (next[1] - from);
+    }
+    if (t == tr->valid_after) /* it counts only after t, so from the right only */
+        *left = *value = 0.0;
+}
+
+/* The first point whose time is at or after t (binary search). */
+static size_t first_at(const trace *tr, double t)
+{
+    size_t lo = 0, hi = tr->n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (point_t(tr, mid) < t)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* Drop the points before the last one at or before t (kept: the next piece starts from it)
+ * and count only after t from now on; *peak takes the largest value dropped (a speed trace).
+ * A trace with nothing after t is emptied (only if it cannot grow: done). */
+static void trim_trace(trace *tr, double t, int done, double *peak)
+{
+    size_t keep_from = first_at(tr, t);
+    if (!(keep_from < tr->n && point_t(tr, keep_from) == t) && keep_from > 0)
+        keep_from--; /* the last point before t starts what is left */
+    if (done && (tr->n == 0 || point_t(tr, tr->n - 1) <= t))
+        keep_from = tr->n;
+    size_t stride = (size_t)tr->stride;
+    for (size_t q = 0; q < keep_from; ++q)
+        *peak = fmax(*peak, tr->samples[stride * q + (stride == 4 ? 2 : 1)]);
+    memmove(tr->samples, tr->samples + stride * keep_from, stride * (tr->n - keep_from) * sizeof *tr->samples);
+    tr->n -= keep_from;
+    tr->valid_after = fmax(tr->valid_after, t);
+}
+
+/* Sum root r's traces up to W (their sample times in (valid_after, W], unioned) into its
+ * rate, and trim them there.  When anything still counts at or before the rate's end (a
+ * rupture merged in, an episode begun at that very instant) the rate so far is summed again
+ * with them, as one more trace; otherwise the new points are appended to it.  Without a rate
+ * only the trimming is done. */
+static int fold(bk_ruptures *b, int32_t r, double W)
+{
+    node *nd = &b->nodes[r];
+    trace *rate = &nd->rate;
+    /* Does anything count at or before the rate's end? */
+    int resum = 0;
+    size_t count = 0;
+    for (int32_t e = nd->head; e != NONE; e = b->episodes[e].next) {
+        const trace *tr = &b->episodes[e].speed;
+        size_t q = tr->n ? first_at(tr, tr->valid_after) : 0;
+        if (q < tr->n && point_t(tr, q) <= tr->valid_after)
+            q++;
+        if (q < tr->n && point_t(tr, q) <= rate->until)
+            resum = 1;
+        count += tr->n;
+    }
+    resum |= nd->absorbed != NONE;
+    if (resum && rate->n > 0) {
+        /* The rate so far becomes a trace to sum like the others: what lies beyond W stays
+         * in it for a later fold. */
+        int32_t k = new_trace(b);
+        if (k == NONE)
+            return BK_ERR_NOMEM;
+        nd = &b->nodes[r];
+        rate = &nd->rate;
+        trace spare = b->traces[k];
+        b->traces[k] = *rate;
+        b->traces[k].valid_after = -INFINITY;
+        b->traces[k].next = nd->absorbed;
+        nd->absorbed = k;
+        nd->held += (long)rate->n;
+        *rate = (trace){spare.samples, 0, spare.capacity, -INFINITY, -INFINITY, NONE, 4};
+    }
+    for (int32_t k = nd->absorbed; k != NONE; k = b->traces[k].next)
+        count += b->traces[k].n;
+    double *grid = bk_grow_array(b->grid, &b->grid_capacity, count ? count : 1, sizeof *grid, 64);
+    if (!grid)
+        return BK_ERR_NOMEM;
+    b->grid = grid;
+    size_t g = 0;
+#define COLLECT(tr)                                                                     \
+    for (size_t q = 0; q < (tr)->n; ++q) {                                              \
+        double t = point_t((tr), q);                                                    \
+        if (t > (tr)->valid_after && t <= (tr)->until && t <= W)                        \
+            grid[g++] = t;                                                              \
+    }
+    for (int32_t e = nd->head; e != NONE; e = b->episodes[e].next)
+        COLLECT(&b->episodes[e].speed)
+    for (int32_t k = nd->absorbed; k != NONE; k = b->traces[k].next)
+        COLLECT(&b->traces[k])
+#undef COLLECT
+    qsort(grid, g, sizeof *grid, compare_double);
+    size_t n_grid = 0;
+    for (size_t q = 0; q < g; ++q)
+        if (n_grid == 0 || grid[q] != grid[n_grid - 1])
+            grid[n_grid++] = grid[q];
+    if (n_grid == 0) { /* nothing settled yet: wait until twice as much is held */
+        long episodes = 0;
+        for (int32_t e = nd->head; e != NONE; e = b->episodes[e].next)
+            episodes++;
+        nd->fold_at = 2 * nd->held > 4 * episodes + 256 ? 2 * nd->held : 4 * episodes + 256;
+        return BK_OK;
+    }
+    double last = grid[n_grid - 1];
+    if (b->keep_rate) {
+        /* Left limit, value and right limit at every grid point, summed trace by trace (each
+         * walked once along the grid): the absorbed sums, then the episodes, in list order. */
+        double *values = bk_grow_array(b->values, &b->values_capacity, 3 * n_grid, sizeof *values, 64);
+        if (!values)
+            return BK_ERR_NOMEM;
+        b->values = values;
+        for (size_t q = 0; q < 3 * n_grid; ++q)
+            values[q] = 0.0;
+#define ADD(tr, ends)                                                                   \
+    do {                                                                                \
+        if ((tr)->n == 0)                                                               \
+            break;                                                                      \
+        size_t cursor = 0, lo = 0, hi = n_grid;                                         \
+        while (lo < hi) { /* the first grid point at or after the trace's first */      \
+            size_t mid = lo + (hi - lo) / 2;                                            \
+            if (grid[mid] < point_t((tr), 0))                                           \
+                lo = mid + 1;                                                           \
+            else                                                                        \
+                hi = mid;                                                               \
+        }                                                                               \
+        for (size_t p = lo; p < n_grid && grid[p] <= point_t((tr), (tr)->n - 1); ++p) { \
+            double l, v, rr;                                                            \
+            trace_at((tr), grid[p], &cursor, (ends), &l, &v, &rr);                      \
+            values[3 * p] += l;                                                         \
+            values[3 * p + 1] += v;                                                     \
+            values[3 * p + 2] += rr;                                                    \
+        }                                                                               \
+    } while (0)
+        for (int32_t k = nd->absorbed; k != NONE; k = b->traces[k].next)
+            ADD(&b->traces[k], 1);
+        for (int32_t e = nd->head; e != NONE; e = b->episodes[e].next)
+            ADD(&b->episodes[e].speed, !b->episodes[e].open);
+#undef ADD
+        size_t base = rate->n;
+        double *grown = bk_grow_array(rate->samples, &rate->capacity, 4 * (base + n_grid), sizeof *grown, 64);
         if (!grown)
             return BK_ERR_NOMEM;
-        ep->samples = grown;
-        ep->samples[2 * ep->n_samples] = t;
-        ep->samples[2 * ep->n_samples + 1] = speed;
-        ep->n_samples++;
+        rate->samples = grown;
+        for (size_t q = 0; q < n_grid; ++q) {
+            double *point = grown + 4 * (base + q);
+            point[0] = grid[q];
+            point[1] = values[3 * q];
+            point[2] = values[3 * q + 1];
+            point[3] = values[3 * q + 2];
+        }
+        rate->n = base + n_grid;
+        rate->until = last;
     }
-    if (dropped) { /* the peak of what is left */
-        ep->peak = 0.0;
-        for (size_t k = 0; k < ep->n_samples; ++k)
-            ep->peak = fmax(ep->peak, ep->samples[2 * k + 1]);
+    /* Trim: what was summed is gone from the traces, but the sample each next piece starts
+     * from. */
+    long held = 0, episodes = 0;
+    for (int32_t e = nd->head; e != NONE; e = b->episodes[e].next) {
+        episode *ep = &b->episodes[e];
+        trim_trace(&ep->speed, last, !ep->open, &ep->peak_folded);
+        held += (long)ep->speed.n;
+        episodes++;
+    }
+    int32_t *link = &nd->absorbed;
+    while (*link != NONE) {
+        int32_t k = *link;
+        double ignored = 0.0;
+        trim_trace(&b->traces[k], last, 1, &ignored);
+        if (b->traces[k].n == 0) {
+            *link = b->traces[k].next;
+            release_trace(b, k);
+        } else {
+            held += (long)b->traces[k].n;
+            link = &b->traces[k].next;
+        }
+    }
+    nd = &b->nodes[r];
+    nd->held = held;
+    nd->fold_at = 2 * held > 4 * episodes + 256 ? 2 * held : 4 * episodes + 256;
+    return BK_OK;
+}
+
+/* Samples up to where every open episode of root r has settled are final: fold there when
+ * the samples held have passed the bound. */
+static int maybe_fold(bk_ruptures *b, int32_t r)
+{
+    if (b->nodes[r].held <= b->nodes[r].fold_at)
+        return BK_OK;
+    double W = INFINITY;
+    for (int32_t e = b->nodes[r].head; e != NONE; e = b->episodes[e].next)
+        if (b->episodes[e].open)
+            W = fmin(W, b->episodes[e].settled);
+    return fold(b, r, W);
+}
+
+/* A speed sample of episode e at t: those after t are dropped (a trajectory the run
+ * discarded), one at t replaced. */
+static int push_sample(bk_ruptures *b, int32_t e, double t, double speed)
+{
+    episode *ep = &b->episodes[e];
+    trace *tr = &ep->speed;
+    if (!(t > tr->valid_after) && tr->valid_after > -INFINITY) {
+        return BK_OK; /* already summed: settled samples are never taken back */
+    }
+    int32_t root = find(b, ep->node);
+    size_t before = tr->n;
+    int recompute = 0;
+    while (tr->n > 0 && tr->samples[2 * (tr->n - 1)] > t) {
+        tr->n--;
+        recompute = 1;
+    }
+    if (tr->n > 0 && tr->samples[2 * (tr->n - 1)] == t) {
+        recompute |= tr->samples[2 * (tr->n - 1) + 1] > speed;
+        tr->samples[2 * (tr->n - 1) + 1] = speed;
+    } else {
+        double *grown = bk_grow_array(tr->samples, &tr->capacity, 2 * (tr->n + 1), sizeof *grown, 8);
+        if (!grown)
+            return BK_ERR_NOMEM;
+        tr->samples = grown;
+        tr->samples[2 * tr->n] = t;
+        tr->samples[2 * tr->n + 1] = speed;
+        tr->n++;
+    }
+    b->nodes[root].held += (long)tr->n - (long)before;
+    if (recompute) { /* the peak of what is left */
+        ep->peak = ep->peak_folded;
+        for (size_t k = 0; k < tr->n; ++k)
+            ep->peak = fmax(ep->peak, tr->samples[2 * k + 1]);
     } else {
         ep->peak = fmax(ep->peak, speed);
     }
-    return BK_OK;
+    return maybe_fold(b, root);
 }
 
 /* ------------------------------------------------------------ the neighbours --- */
@@ -333,11 +671,15 @@ static int onset(bk_ruptures *b, size_t i, double t, double x, double v, double 
     } else {
         root = roots[0];
         for (size_t q = 1; q < n_roots; ++q)
-            merge(b, root, roots[q]);
+            if (merge(b, root, roots[q]) != BK_OK) {
+                release_episode(b, e);
+                return BK_ERR_NOMEM;
+            }
     }
     episode *ep = &b->episodes[e];
     ep->block = (int32_t)i;
     ep->open = 1;
+    ep->settled = t;
     ep->t_onset = t;
     ep->t_stop = NAN;
     ep->x_onset = x;
@@ -346,14 +688,14 @@ static int onset(bk_ruptures *b, size_t i, double t, double x, double v, double 
     b->nodes[root].n_open++;
     b->nodes[root].pending = 0;
     b->latest[i] = e;
-    return push_sample(ep, t, fabs(v));
+    return push_sample(b, e, t, fabs(v));
 }
 
 static int stop(bk_ruptures *b, size_t i, double t, double x, double v, double force)
 {
     int32_t e = b->latest[i];
+    int rc = push_sample(b, e, t, fabs(v));
     episode *ep = &b->episodes[e];
-    int rc = push_sample(ep, t, fabs(v));
     ep->open = 0;
     ep->t_stop = t;
     ep->x_stop = x;
@@ -371,12 +713,6 @@ static int stop(bk_ruptures *b, size_t i, double t, double x, double v, double f
 }
 
 /* ----------------------------------------------------- completing a rupture --- */
-
-static int compare_double(const void *a, const void *c)
-{
-    double x = *(const double *)a, y = *(const double *)c;
-    return (x > y) - (x < y);
-}
 
 /* For qsort of episode indices by (block, onset); the builder is passed through a static
  * pointer, as qsort has no user argument (the builder is not reentrant anyway). */
@@ -431,8 +767,11 @@ void bk_rupture_front_speeds(const bk_rupture_block *blocks, size_t n, int32_t e
         double dr = rows > 1 ? line_distance(e_row, row, rows, ring_rows) : 0.0;
         double d = rows > 1 ? sqrt(dr * dr + dc * dc) : fabs(dc);
         double t = blocks[k].t_onset - t0;
+        /* Sides by column; in the epicentre's column by row, so a one-column lattice reads
+         * as a chain. */
+        double along = dc != 0.0 ? dc : dr;
         for (int side = 0; side < 2; ++side) {
-            if (side == 0 ? dc > 0.0 : dc < 0.0)
+            if (side == 0 ? along > 0.0 : along < 0.0)
                 continue;
             s[side][0] += d;
             s[side][1] += t;
@@ -456,11 +795,9 @@ static int build(bk_ruptures *b, int32_t r, bk_rupture *out, size_t *n_blocks_ou
     if (!order)
         return BK_ERR_NOMEM;
     b->order = order;
-    size_t k = 0, n_samples = 0;
-    for (int32_t e = b->nodes[r].head; e != NONE; e = b->episodes[e].next) {
+    size_t k = 0;
+    for (int32_t e = b->nodes[r].head; e != NONE; e = b->episodes[e].next)
         order[k++] = e;
-        n_samples += b->episodes[e].n_samples;
-    }
     sort_episodes = b->episodes;
     qsort(order, n_ep, sizeof *order, compare_episodes);
 
@@ -516,59 +853,18 @@ static int build(bk_ruptures *b, int32_t r, bk_rupture *out, size_t *n_blocks_ou
     bk_rupture_front_speeds(blocks, n_blocks, rup.first_block, b->rows, b->cols, b->ring_rows, b->ring_cols,
                             &rup.front_speed_left, &rup.front_speed_right);
 
-    /* The rate on the union of the episodes' sample times, each episode linear between its
-     * samples and zero outside them; added in the sorted episode order. */
-    size_t n_rate = 0;
-    if (b->keep_rate && n_samples > 0) {
-        double *grid = bk_grow_array(b->grid, &b->grid_capacity, n_samples, sizeof *grid, 64);
-        if (!grid)
-            return BK_ERR_NOMEM;
-        b->grid = grid;
-        size_t g = 0;
-        for (k = 0; k < n_ep; ++k) {
-            const episode *ep = &b->episodes[order[k]];
-            for (size_t q = 0; q < ep->n_samples; ++q)
-                grid[g++] = ep->samples[2 * q];
-        }
-        qsort(grid, g, sizeof *grid, compare_double);
-        for (size_t q = 0; q < g; ++q)
-            if (n_rate == 0 || grid[q] != grid[n_rate - 1])
-                grid[n_rate++] = grid[q];
-        bk_rupture_rate *rate = bk_grow_array(b->rate_out, &b->rate_out_capacity, n_rate, sizeof *rate, 64);
-        if (!rate)
-            return BK_ERR_NOMEM;
-        b->rate_out = rate;
-        for (size_t q = 0; q < n_rate; ++q)
-            rate[q] = (bk_rupture_rate){.rupture = b->ruptures, .t = grid[q], .rate = 0.0};
-        for (k = 0; k < n_ep; ++k) {
-            const episode *ep = &b->episodes[order[k]];
-            if (ep->n_samples == 0)
-                continue;
-            const double *s = ep->samples;
-            /* The first grid point at or after the episode's first sample. */
-            size_t lo = 0, hi = n_rate;
-            while (lo < hi) {
-                size_t mid = lo + (hi - lo) / 2;
-                if (grid[mid] < s[0])
-                    lo = mid + 1;
-                else
-                    hi = mid;
-            }
-            size_t q = 0;
-            for (size_t p = lo; p < n_rate && grid[p] <= s[2 * (ep->n_samples - 1)]; ++p) {
-                while (q + 1 < ep->n_samples && s[2 * (q + 1)] < grid[p])
-                    q++;
-                double value;
-                if (s[2 * q] == grid[p] || q + 1 == ep->n_samples) {
-                    value = s[2 * q + 1];
-                } else {
-                    double w = (grid[p] - s[2 * q]) / (s[2 * (q + 1)] - s[2 * q]);
-                    value = s[2 * q + 1] + w * (s[2 * q + 3] - s[2 * q + 1]);
-                }
-                rate[p].rate += value;
-            }
-        }
-    }
+    /* The rate: everything folded into the rupture's own trace (every episode has ended). */
+    int rc = fold(b, r, INFINITY);
+    if (rc != BK_OK)
+        return rc;
+    const trace *rate = &b->nodes[r].rate;
+    size_t n_rate = b->keep_rate ? rate->n : 0;
+    bk_rupture_rate *rows = bk_grow_array(b->rate_out, &b->rate_out_capacity, n_rate ? n_rate : 1, sizeof *rows, 64);
+    if (!rows)
+        return BK_ERR_NOMEM;
+    b->rate_out = rows;
+    for (size_t q = 0; q < n_rate; ++q)
+        rows[q] = (bk_rupture_rate){.rupture = b->ruptures, .t = rate->samples[4 * q], .rate = rate->samples[4 * q + 2]};
     *out = rup;
     *n_blocks_out = n_blocks;
     *n_rate_out = n_rate;
@@ -591,6 +887,12 @@ static void release_rupture(bk_ruptures *b, int32_t r)
         b->free_node = m;
         m = next;
     }
+    while (b->nodes[r].absorbed != NONE) {
+        int32_t k = b->nodes[r].absorbed;
+        b->nodes[r].absorbed = b->traces[k].next;
+        release_trace(b, k);
+    }
+    trace_clear(&b->nodes[r].rate);
     b->nodes[r].live = 0;
     b->nodes[r].next_node = b->free_node;
     b->free_node = r;
@@ -714,7 +1016,7 @@ int bk_ruptures_add(bk_ruptures *b, const bk_transition *tr)
     if (slipping && !slips)
         return stop(b, i, tr->t, tr->x, tr->v, tr->force);
     if (slipping) /* a reversal: the same episode goes on */
-        return push_sample(&b->episodes[b->latest[i]], tr->t, fabs(tr->v));
+        return push_sample(b, b->latest[i], tr->t, fabs(tr->v));
     return BK_OK;
 }
 
@@ -733,7 +1035,13 @@ int bk_ruptures_sample(bk_ruptures *b, size_t i, double t, double speed)
 {
     if (!bk_ruptures_slipping(b, i))
         return BK_OK;
-    return push_sample(&b->episodes[b->latest[i]], t, speed);
+    return push_sample(b, b->latest[i], t, speed);
+}
+
+void bk_ruptures_settle(bk_ruptures *b, size_t i, double t)
+{
+    if (bk_ruptures_slipping(b, i))
+        b->episodes[b->latest[i]].settled = fmax(b->episodes[b->latest[i]].settled, t);
 }
 
 int bk_ruptures_finish(bk_ruptures *b, double t, const double *x, const double *v, bk_rupture_force_fn force,
@@ -759,7 +1067,8 @@ int bk_ruptures_finish(bk_ruptures *b, double t, const double *x, const double *
             if (!ep->open)
                 continue;
             size_t i = (size_t)ep->block;
-            rc = push_sample(ep, t, v ? fabs(v[i]) : 0.0);
+            rc = push_sample(b, e, t, v ? fabs(v[i]) : 0.0);
+            ep = &b->episodes[e];
             ep->open = 0;
             ep->t_stop = t;
             ep->x_stop = x[i];
@@ -812,10 +1121,29 @@ void bk_ruptures_counts(const bk_ruptures *b, long *ruptures, long *block_rows, 
 /* ----------------------------------------------------------- checkpoints --- */
 
 /* Values: SAVE_FORMAT, ruptures, block_rows, rate_rows, t_now, roots; per root: pending,
- * episodes; per episode: block, open, t_onset, t_stop, x_onset, x_stop, f_onset, f_stop,
- * peak, samples, then the samples' (t, |v|) pairs.  Roots in pool order, episodes in list
- * order. */
-#define EPISODE_VALUES 10
+ * episodes, fold_at, absorbed traces, its rate trace, the absorbed traces (list order), then
+ * per episode (list order): block, open, t_onset, t_stop, x_onset, x_stop, f_onset, f_stop,
+ * peak, peak_folded, settled and its speed trace.  A trace: valid_after, until, stride,
+ * points, then the points.  Roots in pool order. */
+#define EPISODE_VALUES 11
+#define TRACE_VALUES 4
+
+static size_t trace_values(const trace *tr)
+{
+    return TRACE_VALUES + (size_t)tr->stride * tr->n;
+}
+
+static double *put_trace(double *w, const trace *tr)
+{
+    *w++ = tr->valid_after;
+    *w++ = tr->until;
+    *w++ = tr->stride;
+    *w++ = (double)tr->n;
+    size_t values = (size_t)tr->stride * tr->n;
+    if (values)
+        memcpy(w, tr->samples, values * sizeof *w);
+    return w + values;
+}
 
 size_t bk_ruptures_save(const bk_ruptures *b, double *values, size_t capacity)
 {
@@ -826,9 +1154,11 @@ size_t bk_ruptures_save(const bk_ruptures *b, double *values, size_t capacity)
         if (!nd->live || nd->parent != NONE || nd->head == NONE)
             continue;
         roots++;
-        n += 2;
+        n += 4 + trace_values(&nd->rate);
+        for (int32_t k = nd->absorbed; k != NONE; k = b->traces[k].next)
+            n += trace_values(&b->traces[k]);
         for (int32_t e = nd->head; e != NONE; e = b->episodes[e].next)
-            n += EPISODE_VALUES + 2 * b->episodes[e].n_samples;
+            n += EPISODE_VALUES + trace_values(&b->episodes[e].speed);
     }
     if (capacity < n)
         return n;
@@ -843,11 +1173,18 @@ size_t bk_ruptures_save(const bk_ruptures *b, double *values, size_t capacity)
         const node *nd = &b->nodes[r];
         if (!nd->live || nd->parent != NONE || nd->head == NONE)
             continue;
-        size_t count = 0;
+        size_t episodes = 0, absorbed = 0;
         for (int32_t e = nd->head; e != NONE; e = b->episodes[e].next)
-            count++;
+            episodes++;
+        for (int32_t k = nd->absorbed; k != NONE; k = b->traces[k].next)
+            absorbed++;
         *w++ = nd->pending;
-        *w++ = (double)count;
+        *w++ = (double)episodes;
+        *w++ = (double)nd->fold_at;
+        *w++ = (double)absorbed;
+        w = put_trace(w, &nd->rate);
+        for (int32_t k = nd->absorbed; k != NONE; k = b->traces[k].next)
+            w = put_trace(w, &b->traces[k]);
         for (int32_t e = nd->head; e != NONE; e = b->episodes[e].next) {
             const episode *ep = &b->episodes[e];
             *w++ = ep->block;
@@ -859,9 +1196,9 @@ size_t bk_ruptures_save(const bk_ruptures *b, double *values, size_t capacity)
             *w++ = ep->f_onset;
             *w++ = ep->open ? 0.0 : ep->f_stop;
             *w++ = ep->peak;
-            *w++ = (double)ep->n_samples;
-            memcpy(w, ep->samples, 2 * ep->n_samples * sizeof *w);
-            w += 2 * ep->n_samples;
+            *w++ = ep->peak_folded;
+            *w++ = ep->settled;
+            w = put_trace(w, &ep->speed);
         }
     }
     return n;
@@ -885,6 +1222,35 @@ int bk_ruptures_saved_counts(const double *values, size_t count, long *ruptures,
     return BK_OK;
 }
 
+/* A trace back from values at *at (its buffer reused): a speed trace (stride 2) or a sum
+ * (stride 4), as the caller expects; BK_ERR_INVALID when it does not fit. */
+static int get_trace(const double *values, size_t count, size_t *at, trace *tr, int stride)
+{
+    if (*at + TRACE_VALUES > count || values[*at + 2] != stride || !whole(values[*at + 3], 0, (double)count))
+        return BK_ERR_INVALID;
+    const double *v = values + *at;
+    size_t n = (size_t)v[3], size = (size_t)stride * n;
+    if (*at + TRACE_VALUES + size > count || isnan(v[0]) || isnan(v[1]))
+        return BK_ERR_INVALID;
+    const double *points = v + TRACE_VALUES;
+    for (size_t q = 0; q < n; ++q) /* times in order */
+        if (!isfinite(points[(size_t)stride * q]) ||
+            (q > 0 && !(points[(size_t)stride * q] > points[(size_t)stride * (q - 1)])))
+            return BK_ERR_INVALID;
+    double *grown = bk_grow_array(tr->samples, &tr->capacity, size + 4, sizeof *grown, 8);
+    if (!grown)
+        return BK_ERR_NOMEM;
+    tr->samples = grown;
+    if (size)
+        memcpy(tr->samples, points, size * sizeof *tr->samples);
+    tr->n = n;
+    tr->stride = stride;
+    tr->valid_after = v[0];
+    tr->until = v[1];
+    *at += TRACE_VALUES + size;
+    return BK_OK;
+}
+
 int bk_ruptures_restore(bk_ruptures *b, const double *values, size_t count)
 {
     if (b->n_nodes_pool > 0 || b->n_episodes_pool > 0 || count < 6 || values[0] != SAVE_FORMAT ||
@@ -897,22 +1263,37 @@ int bk_ruptures_restore(bk_ruptures *b, const double *values, size_t count)
     b->t_now = values[4];
     size_t roots = (size_t)values[5], at = 6;
     for (size_t k = 0; k < roots; ++k) {
-        if (at + 2 > count || !whole(values[at], 0, 1) || !whole(values[at + 1], 1, (double)count))
+        if (at + 4 > count || !whole(values[at], 0, 1) || !whole(values[at + 1], 1, (double)count) ||
+            !whole(values[at + 2], 0, 9e15) || !whole(values[at + 3], 0, (double)count))
             return BK_ERR_INVALID;
         int pending = values[at] != 0.0;
-        size_t n_ep = (size_t)values[at + 1];
-        at += 2;
+        size_t n_ep = (size_t)values[at + 1], n_absorbed = (size_t)values[at + 3];
+        long fold_at = (long)values[at + 2];
+        at += 4;
         int32_t r = new_node(b);
         if (r == NONE)
             return BK_ERR_NOMEM;
+        int rc = get_trace(values, count, &at, &b->nodes[r].rate, 4);
+        if (rc != BK_OK)
+            return rc;
+        b->nodes[r].fold_at = fold_at;
+        long held = 0;
+        int32_t *link = &b->nodes[r].absorbed;
+        for (size_t q = 0; q < n_absorbed; ++q) {
+            int32_t t = new_trace(b);
+            if (t == NONE)
+                return BK_ERR_NOMEM;
+            *link = t; /* in list order */
+            link = &b->traces[t].next;
+            if ((rc = get_trace(values, count, &at, &b->traces[t], 4)) != BK_OK)
+                return rc;
+            held += (long)b->traces[t].n;
+        }
         for (size_t q = 0; q < n_ep; ++q) {
             if (at + EPISODE_VALUES > count)
                 return BK_ERR_INVALID;
             const double *v = values + at;
-            if (!whole(v[0], 0, (double)b->n - 1) || !whole(v[1], 0, 1) || !whole(v[9], 0, (double)count))
-                return BK_ERR_INVALID;
-            size_t n_samples = (size_t)v[9];
-            if (at + EPISODE_VALUES + 2 * n_samples > count)
+            if (!whole(v[0], 0, (double)b->n - 1) || !whole(v[1], 0, 1))
                 return BK_ERR_INVALID;
             int32_t e = new_episode(b);
             if (e == NONE)
@@ -926,24 +1307,24 @@ int bk_ruptures_restore(bk_ruptures *b, const double *values, size_t count)
             ep->x_stop = v[5];
             ep->f_onset = v[6];
             ep->f_stop = v[7];
-            double *grown = bk_grow_array(ep->samples, &ep->capacity, 2 * n_samples + 2, sizeof *grown, 8);
-            if (!grown)
-                return BK_ERR_NOMEM;
-            ep->samples = grown;
-            memcpy(ep->samples, v + EPISODE_VALUES, 2 * n_samples * sizeof *ep->samples);
-            ep->n_samples = n_samples;
             ep->peak = v[8];
-            at += EPISODE_VALUES + 2 * n_samples;
+            ep->peak_folded = v[9];
+            ep->settled = v[10];
+            at += EPISODE_VALUES;
             append_episode(b, r, e);
+            if ((rc = get_trace(values, count, &at, &b->episodes[e].speed, 2)) != BK_OK)
+                return rc;
+            ep = &b->episodes[e];
+            held += (long)ep->speed.n;
             b->nodes[r].n_open += ep->open;
             /* The block's latest: the running one, else the latest to stop. */
-            int32_t held = b->latest[ep->block];
-            if (held != NONE && b->episodes[held].open && ep->open)
+            int32_t had = b->latest[ep->block];
+            if (had != NONE && b->episodes[had].open && ep->open)
                 return BK_ERR_INVALID; /* two running episodes of one block */
-            if (held == NONE || ep->open ||
-                (!b->episodes[held].open && ep->t_stop >= b->episodes[held].t_stop))
+            if (had == NONE || ep->open || (!b->episodes[had].open && ep->t_stop >= b->episodes[had].t_stop))
                 b->latest[ep->block] = e;
         }
+        b->nodes[r].held = held;
         if (pending != (b->nodes[r].n_open == 0))
             return BK_ERR_INVALID;
         b->nodes[r].pending = pending;

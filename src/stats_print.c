@@ -22,7 +22,16 @@ int bk_stats_report_text(const bk_stats_report *r, FILE *out, bk_error *err)
 {
     const bk_stats_options *o = &r->options;
     fprintf(out, "catalog: %s\n", r->path);
-    fprintf(out, "  /events: %zu rows; fields beyond t_start, magnitude:%s%s%s%s%s\n", r->n_rows,
+    /* Which table: the default /ruptures, the /events it falls back to, or one named. */
+    const char *what = "";
+    if (r->table && r->table_fallback)
+        what = " (the time-window catalog: the file has no /ruptures)";
+    else if (r->table && strcmp(r->table, "ruptures") == 0)
+        what = " (the rupture catalog)";
+    else if (r->table && strcmp(r->table, "events") == 0)
+        what = " (the time-window catalog)";
+    fprintf(out, "  %s%s%s: %zu rows; fields beyond t_start, magnitude:%s%s%s%s%s\n",
+            r->table ? "/" : "", r->table ? r->table : "table", what, r->n_rows,
             r->has_t_end ? " t_end" : "", r->has_potency ? " potency" : "",
             r->has_n_blocks ? " n_blocks" : "", r->has_complete ? " complete" : "",
             r->has_t_end || r->has_potency || r->has_n_blocks || r->has_complete ? "" : " none");
@@ -160,7 +169,12 @@ int bk_stats_report_json(const bk_stats_report *r, FILE *out, bk_error *err)
     const double absent = NAN;
     fprintf(out, "{\"file\": ");
     json_string_value(out, r->path);
-    fprintf(out, ", ");
+    fprintf(out, ", \"table\": ");
+    if (r->table)
+        json_string_value(out, r->table);
+    else
+        fprintf(out, "null");
+    fprintf(out, ", \"table_fallback\": %s, ", r->table_fallback ? "true" : "false");
     json_count(out, "n_rows", r->n_rows);
     json_count(out, "n_incomplete", r->n_incomplete);
     json_count(out, "n_nonfinite", r->n_nonfinite);

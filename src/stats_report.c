@@ -61,8 +61,10 @@ void bk_event_table_free(bk_event_table *t)
     free(t->magnitude);
     free(t->t_end);
     free(t->potency);
+    free(t->max_slip_rate);
     free(t->n_blocks);
     free(t->complete);
+    free(t->name);
     memset(t, 0, sizeof *t);
 }
 
@@ -349,9 +351,12 @@ int bk_stats_report_compute(const bk_event_table *table, const char *source,
     if (rc != BK_OK)
         return rc;
     bk_stats_report *r = calloc(1, sizeof *r);
-    if (r)
+    if (r) {
         r->path = strdup(source);
-    if (!r || !r->path) {
+        r->table = table->name ? strdup(table->name) : NULL;
+        r->table_fallback = table->fallback;
+    }
+    if (!r || !r->path || (table->name && !r->table)) {
         bk_stats_report_free(r);
         return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", source);
     }
@@ -370,6 +375,7 @@ void bk_stats_report_free(bk_stats_report *r)
     if (!r)
         return;
     free(r->path);
+    free(r->table);
     free(r->t_start);
     free(r->magnitude);
     free(r->potency);

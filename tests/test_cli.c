@@ -237,17 +237,32 @@ static void test_commands(void **state)
     snprintf(cmd, sizeof cmd, "./bksim info %s/nothing.h5", tmpdir);
     assert_int_equal(run_command(cmd, NULL), 1);
 
-    /* stats: a run's output holds its catalog (case A: one slip in 0.65 s); without one, a
-     * message names /events; a table of t_start and magnitude written elsewhere is read. */
+    /* stats: a run's output holds its catalogs (case A: one slip in 0.65 s), the rupture catalog
+     * by default, the time-window catalog with --table events; without one, a message names
+     * /ruptures and /events; a table of t_start and magnitude written elsewhere is read. */
     snprintf(cmd, sizeof cmd, "./bksim stats %s --json", out);
     expect_command(cmd, 0, "\"n_events\": 1,");
+    expect_command(cmd, 0, "\"table\": \"ruptures\", \"table_fallback\": false,");
+    snprintf(cmd, sizeof cmd, "./bksim stats %s", out);
+    expect_command(cmd, 0, "  /ruptures (the rupture catalog): 1 rows");
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --table events --json", out);
+    expect_command(cmd, 0, "\"table\": \"events\", \"table_fallback\": false,");
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --table=/events", out);
+    expect_command(cmd, 0, "  /events (the time-window catalog): 1 rows");
+    /* A table the file lacks: exit 1, naming the file and the table; no name: usage. */
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --table transitions_catalog", out);
+    expect_command(cmd, 1, "good.h5: no /transitions_catalog table");
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --table", out);
+    expect_command(cmd, 2, "unknown or incomplete option '--table'");
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --table=", out);
+    expect_command(cmd, 2, "--table needs a table name");
     char bare[512];
     snprintf(bare, sizeof bare, "%s/bare.h5", tmpdir);
     snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --set run.t_end=0.65 --set output.events=false --quiet", path,
              bare);
     assert_int_equal(run_command(cmd, NULL), 0);
     snprintf(cmd, sizeof cmd, "./bksim stats %s", bare);
-    expect_command(cmd, 1, "/events");
+    expect_command(cmd, 1, "bare.h5: no /ruptures table (the rupture catalog), and no /events");
     char catalog[512];
     snprintf(catalog, sizeof catalog, "%s/catalog.h5", tmpdir);
     typedef struct { double t_start, magnitude; } row;
@@ -270,7 +285,13 @@ static void test_commands(void **state)
     assert_int_equal(run_command(cmd, &text), 0);
     assert_non_null(strstr(text, "\"n_events\": 40"));
     assert_non_null(strstr(text, "\"b_value\""));
+    /* Another program's catalog has only /events: the default falls back to it, and says so. */
+    assert_non_null(strstr(text, "\"table\": \"events\", \"table_fallback\": true,"));
     free(text);
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --mc 2.0", catalog);
+    expect_command(cmd, 0, "  /events (the time-window catalog: the file has no /ruptures): 40 rows");
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --table ruptures", catalog);
+    expect_command(cmd, 1, "catalog.h5: no /ruptures table");
     /* t_start 0..39: --from 10 --to=30 keeps 20 of them. */
     snprintf(cmd, sizeof cmd, "./bksim stats %s --mc 2.0 --json --from 10 --to=30", catalog);
     expect_command(cmd, 0, "\"n_outside_window\": 20, \"n_events\": 20");
@@ -282,11 +303,13 @@ static void test_commands(void **state)
     expect_command(cmd, 2, "time window [30, 10) s");
     assert_int_equal(run_command("./bksim stats", NULL), 2);
 
-    const char *helps[] = {"run", "check", "info", "export", "keys", "stats"};
-    for (size_t k = 0; k < 6; ++k) {
+    const char *helps[] = {"run", "check", "info", "export", "keys", "stats", "summary"};
+    for (size_t k = 0; k < 7; ++k) {
         snprintf(cmd, sizeof cmd, "./bksim %s --help", helps[k]);
         expect_command(cmd, 0, "usage: bksim");
     }
+    expect_command("./bksim stats --help", 0, "  --table NAME      the catalog table: events");
+    expect_command("./bksim --help", 0, "stats FILE [--table NAME]");
     assert_int_equal(run_command("./bksim frobnicate", NULL), 2);
     assert_int_equal(run_command("./bksim", NULL), 2);
     assert_int_equal(run_command("./bksim run", NULL), 2);

@@ -400,6 +400,16 @@ static void test_wall_clock_checkpoint(void **state)
     assert_true(t_checkpoint > 0.0 && t_checkpoint < 20.0);
     snprintf(cmd, sizeof cmd, "./bksim run --restart %s.part --quiet", out);
     assert_int_equal(run_command(cmd, NULL), 0);
+    /* The rupture tables are among what must agree: many ruptures, some of several blocks,
+     * so that ruptures open across the checkpoint were carried over. */
+    bk_rupture *ruptures = NULL;
+    size_t n_ruptures = 0, multi = 0;
+    assert_int_equal(bk_h5_read_ruptures(reference, &ruptures, &n_ruptures, &err), BK_OK);
+    for (size_t k = 0; k < n_ruptures; ++k)
+        multi += ruptures[k].n_blocks > 1;
+    free(ruptures);
+    print_message("%zu ruptures, %zu of several blocks\n", n_ruptures, multi);
+    assert_true(n_ruptures > 100 && multi > 10);
     assert_same_output(reference, out);
     assert_int_equal(bk_h5_verify(out, &err), BK_OK);
 }

@@ -1,6 +1,7 @@
 /* bk_h5_summary (`bksim summary DIR`): the figures of each run against the single block's
- * closed form, the columns of the TSV and of the HDF5 table, and what is left out.  Runs
- * ./bksim from the repository root to make the outputs. */
+ * closed form, the columns of the TSV and of the HDF5 table, and what is left out; the
+ * catalog table behind the figures (/ruptures, else /events, or the one named) against the
+ * tables of a ring's run.  Runs ./bksim from the repository root to make the outputs. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -124,7 +125,7 @@ static void test_figures_and_columns(void **state)
     bk_stats_options_default(&opt);
     bk_error err = {0};
     size_t runs = 0;
-    int rc = bk_h5_summary(dir, &opt, notes, &runs, &err);
+    int rc = bk_h5_summary(dir, NULL, &opt, notes, &runs, &err);
     fclose(notes);
     if (rc != BK_OK)
         print_message("%s\n", err.message);
@@ -156,6 +157,7 @@ static void test_figures_and_columns(void **state)
         /* All events of one block are alike: no b-value. */
         assert_true(isnan(tsv_number(tsv, file, "b_value")));
         assert_string_equal(tsv_field(tsv, file, header_column(tsv, "point")), k ? "p1" : "p0");
+        assert_string_equal(tsv_field(tsv, file, header_column(tsv, "catalog")), "ruptures");
     }
     double period_0, peak_0;
     closed_form(0.1, &period_0, &peak_0);
@@ -163,6 +165,7 @@ static void test_figures_and_columns(void **state)
     assert_true(sampled <= peak_0 * (1.0 + 1e-12) && sampled >= 0.999 * peak_0);
     assert_true(isnan(tsv_number(tsv, "mu_2.h5", "events")));
     assert_true(isnan(tsv_number(tsv, "mu_2.h5", "mean_recurrence")));
+    assert_string_equal(tsv_field(tsv, "mu_2.h5", header_column(tsv, "catalog")), "-");
     /* A text key: set in one run only; "-" where a run did not set it. */
     assert_string_equal(tsv_field(tsv, "mu_0.h5", header_column(tsv, "solver.method")), "-");
     assert_string_equal(tsv_field(tsv, "mu_1.h5", header_column(tsv, "solver.method")), "exact");
@@ -196,6 +199,156 @@ static void test_figures_and_columns(void **state)
     H5Fclose(file);
 }
 
+/* The figures a summary row should hold for the complete rows of a catalog in [t_from, t_to). */
+typedef struct expected {
+    double events, mean_recurrence, largest_magnitude, largest_blocks, peak;
+} expected;
+
+static void expect_row(expected *e, size_t n, const double *t_start, const double *magnitude,
+                       const int32_t *n_blocks, const double *max_slip_rate, const int8_t *complete)
+{
+    double first = INFINITY, last = -INFINITY;
+    *e = (expected){0.0, NAN, -INFINITY, NAN, -INFINITY};
+    for (size_t i = 0; i < n; ++i) {
+        if (!complete[i])
+            continue;
+        e->events += 1.0;
+        first = fmin(first, t_start[i]);
+        last = fmax(last, t_start[i]);
+        if (magnitude[i] > e->largest_magnitude) {
+            e->largest_magnitude = magnitude[i];
+            e->largest_blocks = n_blocks[i];
+        }
+        e->peak = fmax(e->peak, max_slip_rate[i]);
+    }
+    e->mean_recurrence = (last - first) / (e->events - 1.0);
+}
+
+static void check_row(const char *tsv, const char *file, const char *catalog, const expected *e)
+{
+    assert_string_equal(tsv_field(tsv, file, header_column(tsv, "catalog")), catalog);
+    assert_close(tsv_number(tsv, file, "events"), e->events, 0.0, 0.0);
+    assert_close(tsv_number(tsv, file, "mean_recurrence"), e->mean_recurrence, 1e-11, 0.0);
+    assert_close(tsv_number(tsv, file, "largest_magnitude"), e->largest_magnitude, 1e-11, 0.0);
+    assert_close(tsv_number(tsv, file, "largest_event_blocks"), e->largest_blocks, 0.0, 0.0);
+    assert_close(tsv_number(tsv, file, "peak_slip_rate"), e->peak, 1e-11, 0.0);
+}
+
+/* bk_h5_summary into dir with table, notes to a file; returns its status, the notes in *text. */
+static int summarise_dir(const char *dir, const char *table, size_t *runs, char **text, bk_error *err)
+{
+    char notes_path[600], cmd[700];
+    snprintf(notes_path, sizeof notes_path, "%s/notes.txt", tmpdir);
+    FILE *notes = fopen(notes_path, "w");
+    assert_non_null(notes);
+    bk_stats_options opt;
+    bk_stats_options_default(&opt);
+    int rc = bk_h5_summary(dir, table, &opt, notes, runs, err);
+    fclose(notes);
+    snprintf(cmd, sizeof cmd, "cat %s", notes_path);
+    assert_int_equal(run_command(cmd, text), 0);
+    return rc;
+}
+
+/* A ring of 100 blocks, whose 20-odd events hold 200-odd ruptures: by default every catalog
+ * figure is the ruptures'; --table events gives the events'; a run without /ruptures (as
+ * written before there were ruptures) falls back to /events, and says so; a run without a
+ * table named is left out. */
+static void test_catalog_table(void **state)
+{
+    (void)state;
+    char dir[300], cmd[4096], ring[400], old[400], tsv[400];
+    snprintf(dir, sizeof dir, "%s/ring", tmpdir);
+    snprintf(ring, sizeof ring, "%s/ring.h5", dir);
+    snprintf(old, sizeof old, "%s/old.h5", dir);
+    snprintf(tsv, sizeof tsv, "%s/summary.tsv", dir);
+    snprintf(cmd, sizeof cmd, "./bksim run configs/chains/carlson_langer_100.ini -q -o %s --set run.t_end=150 "
+             "&& cp %s %s", ring, ring, old);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    hid_t file = H5Fopen(old, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(file >= 0);
+    assert_true(H5Ldelete(file, "ruptures", H5P_DEFAULT) >= 0);
+    H5Fclose(file);
+
+    bk_error err = {0};
+    bk_rupture *ruptures = NULL;
+    bk_event *events = NULL;
+    size_t n_ruptures = 0, n_events = 0;
+    assert_int_equal(bk_h5_read_ruptures(ring, &ruptures, &n_ruptures, &err), BK_OK);
+    assert_int_equal(bk_h5_read_events(ring, &events, &n_events, &err), BK_OK);
+    double *t = malloc((n_ruptures + n_events) * sizeof *t), *m = malloc((n_ruptures + n_events) * sizeof *m);
+    double *v = malloc((n_ruptures + n_events) * sizeof *v);
+    int32_t *b = malloc((n_ruptures + n_events) * sizeof *b);
+    int8_t *c = malloc(n_ruptures + n_events);
+    assert_true(t && m && v && b && c);
+    for (size_t i = 0; i < n_ruptures; ++i)
+        t[i] = ruptures[i].t_start, m[i] = ruptures[i].magnitude, b[i] = ruptures[i].n_blocks,
+        v[i] = ruptures[i].max_slip_rate, c[i] = ruptures[i].complete;
+    expected from_ruptures, from_events;
+    expect_row(&from_ruptures, n_ruptures, t, m, b, v, c);
+    for (size_t i = 0; i < n_events; ++i)
+        t[i] = events[i].t_start, m[i] = events[i].magnitude, b[i] = events[i].n_blocks,
+        v[i] = events[i].max_slip_rate, c[i] = events[i].complete;
+    expect_row(&from_events, n_events, t, m, b, v, c);
+    free(t), free(m), free(v), free(b), free(c);
+    free(ruptures);
+    free(events);
+    /* The two catalogs differ, so the figures say which was read. */
+    assert_true(from_events.events >= 10.0 && from_ruptures.events > 3.0 * from_events.events);
+
+    /* Default: the ruptures, and for old.h5 its /events, said once on the notes. */
+    size_t runs = 0;
+    char *text = NULL;
+    assert_int_equal(summarise_dir(dir, NULL, &runs, &text, &err), BK_OK);
+    assert_int_equal(runs, 2);
+    assert_non_null(strstr(text, "1 of 2 runs have no /ruptures table: their catalog figures are from /events"));
+    free(text);
+    check_row(tsv, "ring.h5", "ruptures", &from_ruptures);
+    check_row(tsv, "old.h5", "events", &from_events);
+    /* The b-value is `bksim stats`'s of the same table. */
+    bk_stats_report *report = NULL;
+    assert_int_equal(bk_stats_report_read(ring, NULL, NULL, &report, &err), BK_OK);
+    assert_true(report->have_b);
+    assert_close(tsv_number(tsv, "ring.h5", "b_value"), report->b.b, 1e-11, 0.0);
+    assert_close(tsv_number(tsv, "ring.h5", "b_events"), (double)report->b.n, 0.0, 0.0);
+    bk_stats_report_free(report);
+
+    /* --table events: the events of both, no fallback to tell. */
+    assert_int_equal(summarise_dir(dir, "events", &runs, &text, &err), BK_OK);
+    assert_int_equal(runs, 2);
+    assert_null(strstr(text, "no /ruptures"));
+    free(text);
+    check_row(tsv, "ring.h5", "events", &from_events);
+    check_row(tsv, "old.h5", "events", &from_events);
+
+    /* --table ruptures: old.h5 has none and is left out, named with the table. */
+    assert_int_equal(summarise_dir(dir, "/ruptures", &runs, &text, &err), BK_OK);
+    assert_int_equal(runs, 1);
+    assert_non_null(strstr(text, "old.h5: no /ruptures table (--table ruptures)"));
+    free(text);
+    check_row(tsv, "ring.h5", "ruptures", &from_ruptures);
+
+    /* A table no run has: nothing to summarise, an error naming it; on the command line, exit 1. */
+    assert_int_equal(summarise_dir(dir, "rupture_catalog", &runs, &text, &err), BK_ERR_INVALID);
+    assert_non_null(strstr(text, "ring.h5: no /rupture_catalog table"));
+    free(text);
+    assert_non_null(strstr(err.message, dir));
+    assert_non_null(strstr(err.message, "with a /rupture_catalog table"));
+    snprintf(cmd, sizeof cmd, "./bksim summary %s --table rupture_catalog", dir);
+    expect_command(cmd, 1, "old.h5: no /rupture_catalog table");
+    snprintf(cmd, sizeof cmd, "./bksim summary %s --table=events", dir);
+    expect_command(cmd, 0, "2 runs");
+    assert_string_equal(tsv_field(tsv, "ring.h5", header_column(tsv, "catalog")), "events");
+    snprintf(cmd, sizeof cmd, "./bksim summary %s", dir);
+    expect_command(cmd, 0, "their catalog figures are from /events");
+    assert_string_equal(tsv_field(tsv, "ring.h5", header_column(tsv, "catalog")), "ruptures");
+    snprintf(cmd, sizeof cmd, "./bksim summary %s --table", dir);
+    expect_command(cmd, 2, "unknown or incomplete option '--table'");
+    snprintf(cmd, sizeof cmd, "./bksim summary %s --table=", dir);
+    expect_command(cmd, 2, "--table needs a table name");
+    expect_command("./bksim summary --help", 0, "--table NAME");
+}
+
 static void test_nothing_to_summarise(void **state)
 {
     (void)state;
@@ -207,13 +360,13 @@ static void test_nothing_to_summarise(void **state)
     bk_stats_options opt;
     bk_stats_options_default(&opt);
     bk_error err = {0};
-    assert_int_equal(bk_h5_summary(dir, &opt, NULL, NULL, &err), BK_ERR_INVALID);
+    assert_int_equal(bk_h5_summary(dir, NULL, &opt, NULL, NULL, &err), BK_ERR_INVALID);
     assert_non_null(strstr(err.message, "no finished bksim output"));
     char path[600];
     snprintf(path, sizeof path, "%s/summary.tsv", dir);
     assert_false(path_exists(path));
     snprintf(path, sizeof path, "%s/none", tmpdir);
-    assert_int_equal(bk_h5_summary(path, &opt, NULL, NULL, &err), BK_ERR_IO);
+    assert_int_equal(bk_h5_summary(path, NULL, &opt, NULL, NULL, &err), BK_ERR_IO);
     assert_non_null(strstr(err.message, "cannot read the directory"));
     /* The command line: exit 1 with the message; bad options exit 2. */
     snprintf(cmd, sizeof cmd, "./bksim summary %s", dir);
@@ -229,6 +382,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_figures_and_columns),
+        cmocka_unit_test(test_catalog_table),
         cmocka_unit_test(test_nothing_to_summarise),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -1,6 +1,6 @@
 /* The scripts under scripts/ end to end, as a user runs them: summary.sh, the paper's plot
- * scripts, the catalog's (event_ruptures.sh, plot_mfd.sh, plot_slip_map.sh) and the
- * benchmarks' smoke runs (bench.sh --quick, bench_output.sh --quick); sweep.sh is
+ * scripts, the catalogs' (event_ruptures.sh, plot_mfd.sh, plot_slip_map.sh, plot_ruptures.sh)
+ * and the benchmarks' smoke runs (bench.sh --quick, bench_output.sh --quick); sweep.sh is
  * test_sweep.c's.  Runs from the repository root, with ./bksim (or $BKSIM). */
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
@@ -13,6 +13,11 @@
 #include "files.h"
 
 static char tmpdir[256];
+/* A 4 x 5 Coulomb lattice for half a second: a few ruptures, the largest still running at the end. */
+static const char sheet_ini[] = "[model]\nrows = 4\ncols = 5\ncoupling_stiffness = 2e4\n"
+                                "[block]\nmass = 1\ndriver_stiffness = 1e4\nx_init_random = 2e-5\n"
+                                "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
+                                "[driver]\nvelocity = 1e-3\n[output]\ninterval = 0\n[run]\nt_end = 0.5\n";
 
 static int setup(void **state)
 {
@@ -85,9 +90,10 @@ static void test_plot_scripts(void **state)
     }
 }
 
-/* The catalog's scripts on a 40-block chain whose ends fail 1 ms apart and slip at once
+/* The catalogs' scripts on a 40-block chain whose ends fail 1 ms apart and slip at once
  * (test_run_catalog.c's overlap scene): its first event holds two separate ruptures, which
- * event_ruptures.sh counts; plot_mfd.sh draws both figures. */
+ * event_ruptures.sh counts from /ruptures; plot_mfd.sh draws both figures of either catalog;
+ * a file without the rupture catalog is a clear error to each. */
 static void test_catalog_scripts(void **state)
 {
     (void)state;
@@ -112,31 +118,37 @@ static void test_catalog_scripts(void **state)
     assert_true(n_blocks >= 2 && ruptures == 2);
     assert_non_null(strstr(text, "(100.0 %) hold two or more separate ruptures; 2 ruptures in all"));
     free(text);
-    /* Without transitions there is nothing to count: an error, not a count of 0. */
-    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s/bare.h5 --set output.transitions=false --quiet "
+    /* Without the rupture catalog there is nothing to count: an error, not a count of 0. */
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s/bare.h5 --set output.events=false --quiet "
              "&& BKSIM=%s scripts/event_ruptures.sh %s/bare.h5", path, tmpdir, bin, tmpdir);
-    expect_command(cmd, 1, "transitions off");
+    expect_command(cmd, 1, "no table /ruptures");
 
-    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_mfd.sh -o %s/fig %s", bin, tmpdir, out);
-    assert_int_equal(run_command(cmd, &text), 0);
-    free(text);
-    snprintf(cmd, sizeof cmd, "%s/fig/ends_mfd.png", tmpdir);
-    assert_true(path_exists(cmd));
-    snprintf(cmd, sizeof cmd, "%s/fig/ends_spacetime.png", tmpdir);
-    assert_true(path_exists(cmd));
+    /* /ruptures by default, /events with --table events (the figures' names say which). */
+    static const char *const mfd_runs[][2] = {{"", "ends_ruptures"}, {"--table events", "ends"}};
+    for (size_t k = 0; k < 2; ++k) {
+        snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_mfd.sh %s -o %s/fig %s", bin, mfd_runs[k][0], tmpdir, out);
+        assert_int_equal(run_command(cmd, &text), 0);
+        free(text);
+        snprintf(cmd, sizeof cmd, "%s/fig/%s_mfd.png", tmpdir, mfd_runs[k][1]);
+        assert_true(path_exists(cmd));
+        snprintf(cmd, sizeof cmd, "%s/fig/%s_spacetime.png", tmpdir, mfd_runs[k][1]);
+        assert_true(path_exists(cmd));
+    }
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_mfd.sh -o %s/fig %s/bare.h5", bin, tmpdir, tmpdir);
+    expect_command(cmd, 1, "no table /ruptures");
+    snprintf(cmd, sizeof cmd, "scripts/plot_mfd.sh --table quakes %s", out);
+    expect_command(cmd, 2, "--table must be ruptures or events");
 
-    /* plot_slip_map.sh on a 4 x 5 lattice: the largest event, a chosen one, and one past the end. */
+    /* plot_slip_map.sh on a 4 x 5 lattice: the largest rupture, a chosen event, and rows past
+     * either table's end. */
     snprintf(path, sizeof path, "%s/sheet.ini", tmpdir);
-    const char *sheet = "[model]\nrows = 4\ncols = 5\ncoupling_stiffness = 2e4\n"
-                        "[block]\nmass = 1\ndriver_stiffness = 1e4\nx_init_random = 2e-5\n"
-                        "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
-                        "[driver]\nvelocity = 1e-3\n[output]\ninterval = 0\n[run]\nt_end = 0.5\n";
-    assert_int_equal(write_text(path, sheet), 0);
+    assert_int_equal(write_text(path, sheet_ini), 0);
     snprintf(cmd, sizeof cmd, "./bksim run %s -o %s/sheet.h5 --quiet", path, tmpdir);
     assert_int_equal(run_command(cmd, NULL), 0);
     snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh -o %s/fig %s/sheet.h5", bin, tmpdir, tmpdir);
     assert_int_equal(run_command(cmd, &text), 0);
-    assert_non_null(strstr(text, "/fig/sheet_slip_map_"));
+    assert_non_null(strstr(text, "/fig/sheet_rupture_"));
+    assert_non_null(strstr(text, "_slip_map.png"));
     free(text);
     snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh --format svg --event 0 -o %s/fig %s/sheet.h5", bin,
              tmpdir, tmpdir);
@@ -150,6 +162,110 @@ static void test_catalog_scripts(void **state)
     snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh --event 99999 -o %s/fig %s/sheet.h5", bin, tmpdir,
              tmpdir);
     expect_command(cmd, 1, "out of range");
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh --rupture 99999 -o %s/fig %s/sheet.h5", bin, tmpdir,
+             tmpdir);
+    expect_command(cmd, 1, "--rupture 99999 out of range: /ruptures has");
+    snprintf(cmd, sizeof cmd, "scripts/plot_slip_map.sh --rupture 0 --table events %s/sheet.h5", tmpdir);
+    expect_command(cmd, 2, "--rupture K reads /ruptures");
+}
+
+/* Every line of text naming a file under dir (the figures a plot script printed) exists;
+ * returns how many there were. */
+static int printed_files_exist(char *text, const char *dir)
+{
+    int count = 0;
+    for (char *line = strtok(text, "\n"); line; line = strtok(NULL, "\n")) {
+        if (strncmp(line, dir, strlen(dir)) != 0)
+            continue;
+        if (!path_exists(line))
+            fail_msg("%s: printed, but not written", line);
+        ++count;
+    }
+    return count;
+}
+
+/* plot_ruptures.sh on a 60-block chain (a second of stick-slip: about 70 ruptures of 1 to 28
+ * blocks) and on a 4 x 5 lattice: its figures in png (the chain's four, the lattice's three:
+ * no space-time plot), the fits' TSV, and a clear refusal of bad input. */
+static void test_rupture_scripts(void **state)
+{
+    (void)state;
+    char ini[300], chain[300], cmd[4096];
+    char *text = NULL;
+    const char *bin = bksim_binary();
+    snprintf(ini, sizeof ini, "%s/chain60.ini", tmpdir);
+    snprintf(chain, sizeof chain, "%s/chain60.h5", tmpdir);
+    const char *scene = "[model]\nn_blocks = 60\ncoupling_stiffness = 2e4\nseed = 3\n"
+                        "[block]\nmass = 1\ndriver_stiffness = 1e4\nx_init_random = 6e-5\n"
+                        "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n"
+                        "[driver]\nvelocity = 1e-3\n[output]\ninterval = 0\n[run]\nt_end = 1\n";
+    assert_int_equal(write_text(ini, scene), 0);
+    snprintf(cmd, sizeof cmd,
+             "./bksim run %s -o %s --quiet && "
+             "./bksim run %s -o %s/chain60_norate.h5 --quiet --set catalog.rupture_rate=false && "
+             "./bksim run %s -o %s/chain60_bare.h5 --quiet --set output.events=false",
+             ini, chain, ini, tmpdir, ini, tmpdir);
+    assert_int_equal(run_command(cmd, NULL), 0);
+
+    /* The largest rupture: four figures, and a fit per size range and for all. */
+    char figs[300];
+    snprintf(figs, sizeof figs, "%s/rup", tmpdir);
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_ruptures.sh -o %s %s", bin, figs, chain);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_non_null(strstr(text, "# range\tn_ruptures[1]\tslope[1]\tslope_error[1]"));
+    assert_non_null(strstr(text, "\nn_blocks 1-3\t"));
+    assert_non_null(strstr(text, "\nn_blocks 4-30\t"));
+    assert_non_null(strstr(text, "\nall\t"));
+    for (const char *name = "_ruptures_slip_spacetime.png\0_front.png\0_rate.png\0_ruptures_moment_duration.png\0";
+         *name; name += strlen(name) + 1)
+        assert_non_null(strstr(text, name));
+    assert_int_equal(printed_files_exist(text, figs), 4);
+    free(text);
+
+    /* A chosen rupture in a time window, drawn as svg: its front's legend states both speeds. */
+    snprintf(cmd, sizeof cmd,
+             "BKSIM=%s scripts/plot_ruptures.sh --format svg --rupture 0 --from 0.2 --to 0.6 --by duration -o %s %s "
+             "> /dev/null && grep -c -e 'left front: ' -e 'right front: ' %s/chain60_rupture_0_front.svg",
+             bin, figs, chain, figs);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_string_equal(text, "2\n");
+    free(text);
+
+    /* Without /rupture_rate: the other figures, and a warning for the moment rate. */
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_ruptures.sh -o %s/norate %s/chain60_norate.h5", bin, tmpdir,
+             tmpdir);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_non_null(strstr(text, "no moment-rate figure"));
+    assert_null(strstr(text, "_rate.png"));
+    free(text);
+
+    /* A lattice: no space-time plot (said on stderr), the three others. */
+    char sheet[300];
+    snprintf(ini, sizeof ini, "%s/sheet45.ini", tmpdir);
+    snprintf(sheet, sizeof sheet, "%s/sheet45.h5", tmpdir);
+    assert_int_equal(write_text(ini, sheet_ini), 0);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --quiet && BKSIM=%s scripts/plot_ruptures.sh -o %s %s", ini,
+             sheet, bin, figs, sheet);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_non_null(strstr(text, "a 4 x 5 lattice: no space-time plot"));
+    assert_int_equal(printed_files_exist(text, figs), 3);
+    free(text);
+
+    /* Bad input: a clear message, exit status 1 (the file) or 2 (the options). */
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_ruptures.sh --rupture 99999 -o %s %s", bin, figs, chain);
+    expect_command(cmd, 1, "--rupture 99999 out of range: /ruptures has");
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_ruptures.sh -o %s %s/chain60_bare.h5", bin, figs, tmpdir);
+    expect_command(cmd, 1, "no table /ruptures");
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_ruptures.sh --from 5 -o %s %s", bin, figs, chain);
+    expect_command(cmd, 1, "no rupture slips between 5 and the end");
+    snprintf(cmd, sizeof cmd, "scripts/plot_ruptures.sh --from 0.8 --to 0.5 %s", chain);
+    expect_command(cmd, 2, "--from must be before --to");
+    snprintf(cmd, sizeof cmd, "scripts/plot_ruptures.sh --by size %s", chain);
+    expect_command(cmd, 2, "--by must be blocks or duration");
+    snprintf(cmd, sizeof cmd, "scripts/plot_ruptures.sh --rupture -1 %s", chain);
+    expect_command(cmd, 2, "--rupture needs a rupture row >= 0");
+    snprintf(cmd, sizeof cmd, "scripts/plot_ruptures.sh %s/missing.h5", tmpdir);
+    expect_command(cmd, 1, "missing.h5: no such file");
 }
 
 /* The benchmark's smoke run: every back-end on case B at three tolerances, all succeed
@@ -230,6 +346,7 @@ int main(void)
         cmocka_unit_test(test_summary_script),
         cmocka_unit_test(test_plot_scripts),
         cmocka_unit_test(test_catalog_scripts),
+        cmocka_unit_test(test_rupture_scripts),
         cmocka_unit_test(test_bench_smoke),
         cmocka_unit_test(test_bench_output_smoke),
     };

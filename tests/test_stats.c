@@ -628,12 +628,19 @@ static void test_report_bksim_catalog(void **state)
     c.magnitude[n + 1] = 9.0, c.n_blocks[n + 1] = 2000;
     double t_reached = t + 0.5;
     bk_event_table table = table_of(&c, t_reached);
+    char name[] = "ruptures"; /* as a reader names the table it read */
+    table.name = name;
 
     bk_stats_options opt;
     bk_stats_options_default(&opt);
     bk_stats_report *rep = NULL;
     bk_error err = {0};
     assert_int_equal(bk_stats_report_compute(&table, "catalog", &opt, &rep, &err), BK_OK);
+    /* The report keeps its own copy of the table's name. */
+    assert_non_null(rep->table);
+    assert_true(rep->table != table.name);
+    assert_string_equal(rep->table, "ruptures");
+    assert_int_equal(rep->table_fallback, 0);
     assert_int_equal(rep->n_rows, rows);
     assert_int_equal(rep->n_incomplete, 1);
     assert_int_equal(rep->n_nonfinite, 1);
@@ -703,6 +710,7 @@ static void test_report_bksim_catalog(void **state)
     char *json = read_text(f);
     fclose(f);
     assert_true(json[0] == '{' && strstr(json, "}\n") != NULL);
+    assert_non_null(strstr(json, "{\"file\": \"catalog\", \"table\": \"ruptures\", \"table_fallback\": false, "));
     assert_close(json_value(json, "n_events"), (double)n, 0.0, 0.0);
     assert_close(json_value(json, "mc"), rep->mc, 0.0, 0.0);
     assert_close(json_value(json, "n_above_mc"), (double)b.n, 0.0, 0.0);
@@ -718,6 +726,7 @@ static void test_report_bksim_catalog(void **state)
     assert_int_equal(bk_stats_report_text(rep, f, &err), BK_OK);
     char *text = read_text(f);
     fclose(f);
+    assert_non_null(strstr(text, "  /ruptures (the rupture catalog): "));
     assert_non_null(strstr(text, "left out: 1 still running at the end (complete = 0), 1 without"));
     assert_non_null(strstr(text, "b-value: "));
     assert_non_null(strstr(text, "maximum curvature + 0.2"));
@@ -739,6 +748,29 @@ static void test_report_bksim_catalog(void **state)
     assert_true(path_exists(file));
 
     bk_stats_report_free(rep);
+
+    /* The same columns as the /events a reader fell back to: the report says so. */
+    char events[] = "events";
+    table.name = events;
+    table.fallback = 1;
+    assert_int_equal(bk_stats_report_compute(&table, "catalog", &opt, &rep, &err), BK_OK);
+    assert_string_equal(rep->table, "events");
+    assert_int_equal(rep->table_fallback, 1);
+    f = tmpfile();
+    assert_int_equal(bk_stats_report_text(rep, f, &err), BK_OK);
+    text = read_text(f);
+    fclose(f);
+    assert_non_null(strstr(text, "  /events (the time-window catalog: the file has no /ruptures): "));
+    free(text);
+    f = tmpfile();
+    assert_int_equal(bk_stats_report_json(rep, f, &err), BK_OK);
+    json = read_text(f);
+    fclose(f);
+    assert_non_null(strstr(json, "\"table\": \"events\", \"table_fallback\": true, "));
+    free(json);
+    bk_stats_report_free(rep);
+    table.name = NULL;
+    table.fallback = 0;
 
     /* A time window: only the events starting in [t_reached / 4, 3 t_reached / 4) count,
      * and the span, the rate and the halves are the window's. */
@@ -847,6 +879,9 @@ static void test_report_foreign_catalog(void **state)
     assert_non_null(strstr(json, "\"potency_exponent\": null"));
     assert_non_null(strstr(json, "\"sizes\": null"));
     assert_non_null(strstr(json, "\"duration_source\": \"catalog\""));
+    /* Columns made in memory name no table. */
+    assert_null(rep->table);
+    assert_non_null(strstr(json, "\"table\": null, \"table_fallback\": false, "));
     free(json);
     bk_stats_report_free(rep);
 

@@ -14,6 +14,7 @@
 #include "bksim/modes.h"
 #include "bksim/output.h"
 #include "bksim/param.h"
+#include "bksim/rupture.h"
 #include "bksim/run.h"
 #include "bksim/sink.h"
 #include "bksim/solver.h"

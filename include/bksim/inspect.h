@@ -1,7 +1,7 @@
 /* HDF5 output, the read side: the summary and integrity check behind `bksim info`, the text
  * export behind `bksim export`, whole-dataset readers, the catalog behind `bksim stats` and
- * the sweep table behind `bksim summary`.  The file layout is described in
- * bksim/output.h (the write side). */
+ * the sweep table behind `bksim summary` (/ruptures by default, or another table by name).
+ * The file layout is described in bksim/output.h (the write side). */
 #ifndef BKSIM_INSPECT_H
 #define BKSIM_INSPECT_H
 
@@ -71,31 +71,49 @@ int bk_h5_read_ruptures(const char *path, bk_rupture **rows, size_t *count, bk_e
 int bk_h5_read_rupture_blocks(const char *path, bk_rupture_block **rows, size_t *count, bk_error *err);
 int bk_h5_read_rupture_rate(const char *path, bk_rupture_rate **rows, size_t *count, bk_error *err);
 
-/* An earthquake catalog's /events table (any HDF5 file: a 1-D compound dataset with at least
- * t_start and magnitude; potency, n_blocks, complete and t_end read when present, in any
- * numeric type) into *table (bk_event_table_free), with the root attribute t_reached of a
- * bksim output (NaN without one).  Fails on a file that cannot be read, has no /events, or
- * whose /events lacks t_start or magnitude; *table is then empty. */
-int bk_h5_read_event_table(const char *path, bk_event_table *table, bk_error *err);
-/* `bksim stats FILE`: bk_h5_read_event_table, then bk_stats_report_compute with the file's
- * path as the source. */
-int bk_stats_report_read(const char *path, const bk_stats_options *opt, bk_stats_report **out,
-                         bk_error *err);
+/* The catalog tables `bksim stats` and `bksim summary` read: by default the rupture catalog
+ * (connected slip episodes, bksim/rupture.h), and, in a file without it (an older bksim
+ * output, another program's catalog), the time-window catalog /events. */
+#define BK_CATALOG_DEFAULT_TABLE "ruptures"
+#define BK_CATALOG_FALLBACK_TABLE "events"
 
-/* `bksim summary DIR`: one row per finished run (complete *.h5) in dir, sorted by file name:
- * file, point (the sweep's grid point), one column per --set key any run used (named by the
- * key, holding that run's value), then its headline figures: events (complete, starting in
- * [opt->t_from, opt->t_to)), mean_recurrence (s, between their starts), largest_magnitude
- * and largest_event_blocks, peak_slip_rate (m/s: the catalog's largest, else the largest |v|
- * of /v), b_value, b_error, mc and b_events (as `bksim stats` with opt gives them),
- * energy_residual, steps, rhs_evals, transitions, t_reached, wall_time, cpu_time, seed,
- * method and host; NaN where a run has no such figure.  Written as dir/summary.tsv (a '#'
- * line with the units, a header of column names, tab-separated rows) and dir/summary.h5
- * (compound dataset /summary with units), each via a temporary name and a rename.  Files
- * left out (a run that did not finish, an HDF5 file that is no bksim output, a damaged
- * file) are named on notes (may be NULL).  *n_runs (may be NULL) gets the row count.
- * BK_ERR_INVALID when dir holds no finished run. */
-int bk_h5_summary(const char *dir, const bk_stats_options *opt, FILE *notes, size_t *n_runs,
-                  bk_error *err);
+/* An earthquake catalog table of any HDF5 file (a 1-D compound dataset with at least t_start
+ * and magnitude; potency, n_blocks, complete, t_end and max_slip_rate read when present, in
+ * any numeric type) into *out (bk_event_table_free), with the root attribute t_reached of a
+ * bksim output (NaN without one).  table names the dataset ("events", "ruptures", a leading
+ * '/' allowed); NULL reads /ruptures, else /events when the file has no /ruptures (then
+ * out->fallback = 1).  out->name is the table read.  Fails (BK_ERR_INVALID, the message
+ * naming the file and the table) on a file without that table, or without either for NULL,
+ * on a table that lacks t_start or magnitude, and on a file that cannot be read; *out is
+ * then empty. */
+int bk_h5_read_event_table(const char *path, const char *table, bk_event_table *out,
+                           bk_error *err);
+/* `bksim stats FILE [--table NAME]`: bk_h5_read_event_table(path, table, ...), then
+ * bk_stats_report_compute with the file's path as the source (the report names the table
+ * and says when the default fell back to /events).  Options are checked first. */
+int bk_stats_report_read(const char *path, const char *table, const bk_stats_options *opt,
+                         bk_stats_report **out, bk_error *err);
+
+/* `bksim summary DIR [--table NAME]`: one row per finished run (complete *.h5) in dir,
+ * sorted by file name: file, point (the sweep's grid point), one column per --set key any
+ * run used (named by the key, holding that run's value), then its headline figures from its
+ * catalog table (table as for bk_h5_read_event_table: NULL for /ruptures, else /events):
+ * events (the table's complete rows, ruptures by default, starting in [opt->t_from,
+ * opt->t_to)), mean_recurrence (s, between their starts), largest_magnitude and
+ * largest_event_blocks (the n_blocks of the largest), peak_slip_rate (m/s: the catalog's
+ * largest max_slip_rate, else the largest |v| of /v), b_value, b_error, mc and b_events (as
+ * `bksim stats` with opt gives them), energy_residual, steps, rhs_evals, transitions,
+ * t_reached, wall_time, cpu_time, seed, method, host and catalog (the table the figures came
+ * from, "-" for a run without a catalog); NaN where a run has no such figure.  With table
+ * NULL a run without any catalog is summarised without the catalog figures; a run without a
+ * table named by table is left out.  Written as dir/summary.tsv (a '#' line with the units, a
+ * header of column names, tab-separated rows) and dir/summary.h5 (compound dataset /summary
+ * with units), each via a temporary name and a rename.  Files left out (a run that did not
+ * finish, an HDF5 file that is no bksim output, a damaged file, a run without the named
+ * table) are named on notes (may be NULL), and so, in one line, are the runs whose default
+ * fell back to /events.  *n_runs (may be NULL) gets the row count.  BK_ERR_INVALID when dir
+ * holds no finished run (with the named table). */
+int bk_h5_summary(const char *dir, const char *table, const bk_stats_options *opt, FILE *notes,
+                  size_t *n_runs, bk_error *err);
 
 #endif

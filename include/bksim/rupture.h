@@ -92,6 +92,9 @@ double bk_ruptures_episode_peak(const bk_ruptures *builder, size_t i);
  * sample at t drops those after t (a trajectory the run discarded when it restarted the
  * block's island at t) and replaces one at t.  Ignored when block i does not slip. */
 int bk_ruptures_sample(bk_ruptures *builder, size_t i, double t, double speed);
+/* Block i's speed samples up to t are final (no restart can drop them any more: its
+ * island's integrator has stepped past t), so they may be summed into its rupture's rate. */
+void bk_ruptures_settle(bk_ruptures *builder, size_t i, double t);
 /* The end of the run at t, with every block's position and velocity (v may be NULL):
  * ruptures pending are emitted complete, those still running with complete = 0 and their
  * open episodes counted to t. */
@@ -117,7 +120,9 @@ int bk_ruptures_saved_counts(const double *values, size_t count, long *ruptures,
  * epicentre included (distance 0) and NaN with fewer than 3 points on a side; +inf when
  * every arrival on the side is simultaneous, NaN when the fit's slope is negative.  On a ring
  * distance goes the shorter way round; on a lattice it is radial, the left side the blocks
- * whose column is at or left of the epicentre's and the right side those at or right of it.
+ * whose column is left of the epicentre's, the right side those right of it, and the
+ * epicentre's own column split by row (above: left; below: right), so that a lattice of one
+ * column reads as a chain.
  * Exposed for tests and readers of /rupture_blocks. */
 void bk_rupture_front_speeds(const bk_rupture_block *blocks, size_t n, int32_t epicentre,
                              size_t rows, size_t cols, int ring_rows, int ring_cols, double *left,

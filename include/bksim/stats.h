@@ -3,7 +3,9 @@
  * Nothing here touches a file format.  The estimators (src/stats.c) are pure numerics on
  * plain arrays; the report (src/stats_report.c) runs them on a catalog's columns in memory
  * (bk_event_table) and is printed by src/stats_print.c.  Reading a catalog from an HDF5 file
- * is the read side's (bksim/inspect.h: bk_h5_read_event_table, bk_stats_report_read).
+ * is the read side's (bksim/inspect.h: bk_h5_read_event_table, bk_stats_report_read), which
+ * also chooses the table: the rupture catalog /ruptures by default, the time-window catalog
+ * /events (or any other) by name.  The report calls each row an event whichever it is.
  *
  * Magnitude bins.  Bins of width dm are centred on multiples of dm: a magnitude M belongs to
  * bin k = floor(M/dm + 0.5 + eps), eps = BK_MAG_BIN_EPS, whose centre is k dm.  The epsilon
@@ -196,16 +198,21 @@ void bk_stats_options_default(bk_stats_options *opt);
 /* BK_ERR_INVALID with a message naming the option and its allowed range. */
 int bk_stats_options_check(const bk_stats_options *opt, bk_error *err);
 
-/* An earthquake catalog's columns in memory, one entry per event: t_start and magnitude
- * always, the others NULL where the catalog has no such field. */
+/* An earthquake catalog's columns in memory, one entry per event (a rupture of /ruptures,
+ * an event of /events, a row of another program's table): t_start and magnitude always, the
+ * others NULL where the catalog has no such field. */
 typedef struct bk_event_table {
     size_t n;
     double *t_start, *magnitude;  /* s, 1 */
     double *t_end, *potency;      /* s, m */
+    double *max_slip_rate;        /* m/s */
     int32_t *n_blocks;
     int8_t *complete;             /* 0: still running at the end of the run */
     double t_reached;             /* s: the simulated span of the run that wrote the catalog
                                      (runs start at t = 0), NaN when that is not known */
+    char *name;                   /* the table the columns were read from ("ruptures",
+                                     "events", ...; malloc'ed), NULL for columns made in memory */
+    int fallback;                 /* 1: the file had no /ruptures, so the default read /events */
 } bk_event_table;
 
 /* Free the columns and zero the table. */
@@ -216,10 +223,12 @@ void bk_event_table_free(bk_event_table *table);
  * its *_note; the report as a whole fails only when the file is no catalog. */
 typedef struct bk_stats_report {
     char *path;
+    char *table;           /* the catalog's table (bk_event_table's name), NULL when unnamed */
+    int table_fallback;    /* 1: /events read because the file has no /ruptures */
     bk_stats_options options;
-    /* the columns found in /events */
+    /* the columns found in the table */
     int has_t_end, has_potency, has_n_blocks, has_complete;
-    size_t n_rows;         /* rows of /events */
+    size_t n_rows;         /* rows of the table */
     size_t n_incomplete;   /* complete = 0: still running at the end, left out */
     size_t n_nonfinite;    /* complete rows without a finite t_start and magnitude */
     size_t n_outside;      /* complete rows starting outside [t_from, t_to) */
@@ -261,7 +270,8 @@ typedef struct bk_stats_report {
 } bk_stats_report;
 
 /* Compute everything from a catalog's columns (opt NULL: the defaults); source names the
- * catalog in the report and in messages.  *out is allocated (bk_stats_report_free).  Fails
+ * catalog in the report and in messages, and the table's name and fallback flag are copied
+ * into it.  *out is allocated (bk_stats_report_free).  Fails
  * only on bad options or lack of memory: a statistic the catalog cannot support is noted in
  * the report. */
 int bk_stats_report_compute(const bk_event_table *table, const char *source,

@@ -35,9 +35,11 @@ static const char *const usage_text =
     "                       print columns for gnuplot and shell tools\n"
     "  export OUT.h5 --events\n"
     "                       print the event catalog /events as TSV\n"
-    "  stats FILE [--mc auto|VALUE] [--bin DM] [--from T] [--to T] [--json] [--tsv DIR]\n"
-    "                       earthquake statistics of the catalog /events in FILE\n"
-    "  summary DIR [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
+    "  stats FILE [--table NAME] [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
+    "        [--json] [--tsv DIR]\n"
+    "                       earthquake statistics of the rupture catalog /ruptures in FILE\n"
+    "                       (else /events; --table events: the time-window catalog)\n"
+    "  summary DIR [--table NAME] [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
     "                       one row per finished run in DIR (a sweep): its --set values\n"
     "                       and headline figures, as DIR/summary.tsv and DIR/summary.h5\n"
     "  keys                 print the config key reference (Markdown)\n"
@@ -113,14 +115,20 @@ static const char *const export_help =
     "                    events, transitions\n";
 
 static const char *const stats_help =
-    "usage: bksim stats FILE [--mc auto|VALUE] [--bin DM] [--from T] [--to T] [--json]\n"
-    "                        [--tsv DIR]\n"
+    "usage: bksim stats FILE [--table NAME] [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
+    "                        [--json] [--tsv DIR]\n"
     "\n"
-    "Statistics of the earthquake catalog /events in the HDF5 file FILE (a table with at\n"
-    "least t_start and magnitude): magnitude-frequency distribution, completeness magnitude\n"
-    "Mc, b-value (Aki-Utsu maximum likelihood, Shi & Bolt error), potency exponent, event\n"
+    "Statistics of an earthquake catalog in the HDF5 file FILE (a table with at least\n"
+    "t_start and magnitude): magnitude-frequency distribution, completeness magnitude Mc,\n"
+    "b-value (Aki-Utsu maximum likelihood, Shi & Bolt error), potency exponent, event\n"
     "sizes, recurrence intervals, and a KS test of the two halves of the run.  Events still\n"
-    "running at the end (complete = 0) are left out.\n"
+    "running at the end (complete = 0) are left out.  The catalog is the rupture catalog\n"
+    "/ruptures (connected slip episodes: one row per rupture); a file without it (an older\n"
+    "bksim output, another program's catalog) falls back to /events, and the report says so\n"
+    "(JSON: \"table\", \"table_fallback\").\n"
+    "  --table NAME      the catalog table: events (the time-window catalog: maximal\n"
+    "                    intervals during which some block slips), ruptures, or any 1-D\n"
+    "                    table of FILE with fields t_start and magnitude; no fallback\n"
     "  --mc auto|VALUE   completeness magnitude: maximum curvature + 0.2 (auto, the\n"
     "                    default) or VALUE, a multiple of the bin width\n"
     "  --bin DM          magnitude bin width, 0 < DM <= 10 (default 0.1)\n"
@@ -132,17 +140,21 @@ static const char *const stats_help =
     "                    potency_ccdf.tsv\n";
 
 static const char *const summary_help =
-    "usage: bksim summary DIR [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
+    "usage: bksim summary DIR [--table NAME] [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
     "\n"
     "One row per finished run (complete *.h5) in DIR, sorted by file name: file, point (the\n"
     "sweep's grid point), a column per --set key of the runs (named by the key: the run's\n"
     "value), then events, mean_recurrence (s), largest_magnitude, largest_event_blocks,\n"
     "peak_slip_rate (m/s), b_value, b_error, mc, b_events (as `bksim stats` gives them),\n"
     "energy_residual, steps, rhs_evals, transitions, t_reached, wall_time, cpu_time (s),\n"
-    "seed, method, host; nan where a run has none.  Written to DIR/summary.tsv (a '#' line\n"
-    "of units, a header line, tab-separated rows: scripts/plot_summary.sh draws any column\n"
-    "against any other) and DIR/summary.h5 (compound dataset /summary).  Runs that did not\n"
-    "finish (*.h5.part) are not summarised; other files left out are named on stderr.\n"
+    "seed, method, host, catalog; nan where a run has none.  The catalog figures (events\n"
+    "to b_events) count the rows of the run's /ruptures (else /events, as `bksim stats`),\n"
+    "and catalog names the table.  Written to DIR/summary.tsv (a '#' line of units, a\n"
+    "header line, tab-separated rows: scripts/plot_summary.sh draws any column against any\n"
+    "other) and DIR/summary.h5 (compound dataset /summary).  Runs that did not finish\n"
+    "(*.h5.part) are not summarised; other files left out are named on stderr.\n"
+    "  --table NAME                as for `bksim stats` (events: the time-window catalog);\n"
+    "                              a run without that table is left out\n"
     "  --mc, --bin, --from, --to   as for `bksim stats`: the catalog figures use them\n";
 
 static const char *const keys_help =
@@ -629,17 +641,17 @@ static int cmd_export(int argc, char **argv)
     return 0;
 }
 
-/* The catalog options of stats and summary (--mc, --bin, --from, --to) at argv[*i]:
- * -1 when argv[*i] is none of them, 0 when taken (*i advanced past a separate value), else
- * the exit status of a usage error.  Ranges (finite, a bin centre, ...) are
- * bk_stats_options_check's. */
+/* The catalog options of stats and summary (--mc, --bin, --from, --to into opt, --table into
+ * *table) at argv[*i]: -1 when argv[*i] is none of them, 0 when taken (*i advanced past a
+ * separate value), else the exit status of a usage error.  Ranges (finite, a bin centre, ...)
+ * are bk_stats_options_check's. */
 static int parse_catalog_option(const char *command, int argc, char **argv, int *i,
-                                bk_stats_options *opt)
+                                bk_stats_options *opt, const char **table)
 {
-    static const char *const names[] = {"--mc", "--bin", "--from", "--to"};
+    static const char *const names[] = {"--mc", "--bin", "--from", "--to", "--table"};
     const char *a = argv[*i], *value = NULL;
     size_t which = 0;
-    for (; which < 4; ++which) {
+    for (; which < 5; ++which) {
         size_t len = strlen(names[which]);
         if (strcmp(a, names[which]) == 0 && *i + 1 < argc) {
             value = argv[++*i];
@@ -654,7 +666,12 @@ static int parse_catalog_option(const char *command, int argc, char **argv, int 
         return -1;
     char *end = NULL;
     errno = 0;
-    if (which == 0) {
+    if (which == 4) {
+        if (!*value || strcmp(value, "/") == 0)
+            return usage_error(command, "%s", "--table needs a table name: ruptures, events, or "
+                                              "another table with t_start and magnitude");
+        *table = value;
+    } else if (which == 0) {
         opt->mc_auto = strcmp(value, "auto") == 0;
         if (!opt->mc_auto) {
             opt->mc = strtod(value, &end);
@@ -682,11 +699,11 @@ static int cmd_stats(int argc, char **argv)
     }
     bk_stats_options opt;
     bk_stats_options_default(&opt);
-    const char *path = NULL, *tsv_dir = NULL;
+    const char *path = NULL, *tsv_dir = NULL, *table = NULL;
     int json = 0;
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
-        int taken = parse_catalog_option("stats", argc, argv, &i, &opt);
+        int taken = parse_catalog_option("stats", argc, argv, &i, &opt, &table);
         if (taken > 0)
             return taken;
         if (taken == 0)
@@ -711,7 +728,7 @@ static int cmd_stats(int argc, char **argv)
     if (bk_stats_options_check(&opt, &err) != BK_OK)
         return usage_error("stats", "%s", err.message);
     bk_stats_report *report = NULL;
-    int rc = bk_stats_report_read(path, &opt, &report, &err);
+    int rc = bk_stats_report_read(path, table, &opt, &report, &err);
     /* Tables first: a directory that cannot be written fails before anything is printed. */
     if (rc == BK_OK && tsv_dir)
         rc = bk_stats_report_tsv(report, tsv_dir, &err);
@@ -734,9 +751,9 @@ static int cmd_summary(int argc, char **argv)
     }
     bk_stats_options opt;
     bk_stats_options_default(&opt);
-    const char *dir = NULL;
+    const char *dir = NULL, *table = NULL;
     for (int i = 0; i < argc; ++i) {
-        int taken = parse_catalog_option("summary", argc, argv, &i, &opt);
+        int taken = parse_catalog_option("summary", argc, argv, &i, &opt, &table);
         if (taken > 0)
             return taken;
         if (taken == 0)
@@ -753,7 +770,7 @@ static int cmd_summary(int argc, char **argv)
     if (bk_stats_options_check(&opt, &err) != BK_OK)
         return usage_error("summary", "%s", err.message);
     size_t runs = 0;
-    if (bk_h5_summary(dir, &opt, stderr, &runs, &err) != BK_OK) {
+    if (bk_h5_summary(dir, table, &opt, stderr, &runs, &err) != BK_OK) {
         fprintf(stderr, "%s\n", err.message);
         return EXIT_RUN_FAILED;
     }

@@ -281,6 +281,8 @@ static int info_in_progress(const char *path, FILE *out, bk_error *err)
     else
         fprintf(out, "checkpoint   none yet\n");
     fprintf(out, "rows         %llu so far\n", rows);
+    if (H5Lexists(file, "ruptures", H5P_DEFAULT) > 0)
+        fprintf(out, "ruptures     %llu so far\n", flushed_rows(file, "ruptures"));
     if (H5Lexists(file, "events", H5P_DEFAULT) > 0)
         fprintf(out, "events       %llu so far\n", events);
     free(name);
@@ -416,8 +418,16 @@ int bk_h5_info_blocks(const char *path, FILE *out, int per_block, bk_error *err)
     hsize_t n_events = 0;
     int have_events = bk_h5_open_events(file, path, &events, &event_type, &n_events, NULL) == BK_OK;
     CLOSE_IDS(0, event_type, events);
+    if (H5Lexists(file, "ruptures", H5P_DEFAULT) > 0) {
+        unsigned long long n_ruptures = flushed_rows(file, "ruptures");
+        fprintf(out, "ruptures     %llu (the rupture catalog: bksim stats %s; bksim export %s --table ruptures)\n",
+                n_ruptures, path, path);
+    } else {
+        fprintf(out, "ruptures     not recorded\n");
+    }
     if (have_events)
-        fprintf(out, "events       %llu (the catalog: bksim stats %s)\n", (unsigned long long)n_events, path);
+        fprintf(out, "events       %llu (time windows: bksim stats %s --table events)\n", (unsigned long long)n_events,
+                path);
     else
         fprintf(out, "events       not recorded\n");
     print_stats(file, out);

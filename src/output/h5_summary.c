@@ -1,6 +1,9 @@
 /* `bksim summary DIR`: one row per finished run in DIR, its --set values beside its headline
  * figures, as DIR/summary.tsv (for gnuplot and shell tools) and DIR/summary.h5 (one compound
- * table).  Both are written to a temporary name and renamed, so neither is ever half written. */
+ * table).  Both are written to a temporary name and renamed, so neither is ever half written.
+ * The catalog figures (events, mean_recurrence, largest_*, peak_slip_rate, the b-value) come
+ * from one table of each run, /ruptures by default (else /events), named in column catalog;
+ * the column names say "events" whichever table it is. */
 #include "bksim/inspect.h"
 
 #include <dirent.h>
@@ -10,7 +13,6 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "bksim/catalog.h"
 #include "bksim/config.h"
 #include "bksim/friction.h"
 #include "bksim/stats.h"
@@ -63,6 +65,8 @@ static const struct {
 
 typedef struct run_row {
     char *file, *point, *method, *host;
+    char *catalog;   /* the table behind the catalog figures; NULL: the run has no catalog */
+    int fallback;    /* 1: no /ruptures, so the default read /events */
     char **values;   /* per key column; NULL where the run did not set that key */
     size_t n_values; /* entries allocated in values */
     double figure[N_FIGURES];
@@ -84,6 +88,7 @@ static void free_row(run_row *run)
     free(run->point);
     free(run->method);
     free(run->host);
+    free(run->catalog);
 }
 
 static void free_summary(summary *s)
@@ -151,6 +156,14 @@ static int take_overrides(summary *s, run_row *run, const char *overrides)
     return 0;
 }
 
+static int link_exists(hid_t file, const char *name)
+{
+    htri_t exists = H5Lexists(file, name, H5P_DEFAULT);
+    if (exists < 0) /* a group on the way that is not there */
+        H5Eclear2(H5E_DEFAULT);
+    return exists > 0;
+}
+
 static double numeric_attr(hid_t obj, const char *name)
 {
     double value = NAN;
@@ -159,49 +172,55 @@ static double numeric_attr(hid_t obj, const char *name)
     return value;
 }
 
-/* The catalog's figures: events in the window, their mean recurrence, the largest, the
- * peak slip rate; and the b-value of `bksim stats` with the same options. */
-static int catalog_figures(const char *path, const bk_stats_options *opt, run_row *run, bk_error *err)
+/* The catalog's figures from its table (NULL: /ruptures, else /events): events in the window,
+ * their mean recurrence, the largest, the peak slip rate; and the b-value of `bksim stats`
+ * with the same options. */
+static int catalog_figures(const char *path, const char *table, const bk_stats_options *opt,
+                           run_row *run, bk_error *err)
 {
-    bk_event *events = NULL;
-    size_t n = 0;
-    int rc = bk_h5_read_events(path, &events, &n, err);
+    bk_event_table t;
+    int rc = bk_h5_read_event_table(path, table, &t, err);
     if (rc != BK_OK)
         return rc;
     size_t counted = 0;
     double first = NAN, last = NAN, largest = -INFINITY, largest_blocks = NAN, peak = NAN;
-    for (size_t i = 0; i < n; ++i) {
-        const bk_event *e = &events[i];
-        if (!e->complete || !(e->t_start >= opt->t_from && e->t_start < opt->t_to))
+    for (size_t i = 0; i < t.n; ++i) {
+        if ((t.complete && !t.complete[i]) || !(t.t_start[i] >= opt->t_from && t.t_start[i] < opt->t_to))
             continue;
-        if (counted++ == 0)
-            first = e->t_start;
-        last = e->t_start;
-        if (e->magnitude > largest) {
-            largest = e->magnitude;
-            largest_blocks = e->n_blocks;
+        /* Ruptures are stored as they complete, so their starts need not be in order. */
+        if (counted++ == 0 || t.t_start[i] < first)
+            first = t.t_start[i];
+        if (!(t.t_start[i] <= last))
+            last = t.t_start[i];
+        if (t.magnitude[i] > largest) {
+            largest = t.magnitude[i];
+            largest_blocks = t.n_blocks ? (double)t.n_blocks[i] : NAN;
         }
-        if (!(e->max_slip_rate <= peak))
-            peak = e->max_slip_rate;
+        if (t.max_slip_rate && !(t.max_slip_rate[i] <= peak))
+            peak = t.max_slip_rate[i];
     }
-    free(events);
     run->figure[FIG_EVENTS] = (double)counted;
-    /* Events never overlap, so the starts are in order and the mean interval is the span's. */
+    /* The mean of the intervals between consecutive starts is the span's over their number. */
     run->figure[FIG_MEAN_RECURRENCE] = counted >= 2 ? (last - first) / (double)(counted - 1) : NAN;
     run->figure[FIG_LARGEST_MAGNITUDE] = counted ? largest : NAN;
     run->figure[FIG_LARGEST_BLOCKS] = largest_blocks;
     run->figure[FIG_PEAK_SLIP_RATE] = peak;
+    run->fallback = t.fallback;
+    if (!(run->catalog = strdup(t.name)))
+        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
 
     bk_stats_report *report = NULL;
     bk_error ignored = {0};
-    if (counted && bk_stats_report_read(path, opt, &report, &ignored) == BK_OK && report->have_b) {
+    if (rc == BK_OK && counted && bk_stats_report_compute(&t, path, opt, &report, &ignored) == BK_OK &&
+        report->have_b) {
         run->figure[FIG_B_VALUE] = report->b.b;
         run->figure[FIG_B_ERROR] = report->b.sigma;
         run->figure[FIG_MC] = report->b.mc;
         run->figure[FIG_B_EVENTS] = (double)report->b.n;
     }
     bk_stats_report_free(report);
-    return BK_OK;
+    bk_event_table_free(&t);
+    return rc;
 }
 
 /* Without a catalog the peak slip rate is the time series' largest |v|, read a slab of
@@ -235,10 +254,11 @@ static int series_peak_slip_rate(hid_t file, const char *path, run_row *run, bk_
     return rc;
 }
 
-/* One output file into a row.  BK_INCOMPLETE for a run that did not finish and
- * BK_ERR_INVALID for an HDF5 file that is no bksim output: both are left out, with a note. */
-static int read_run(summary *s, const char *dir, const char *name, const bk_stats_options *opt,
-                    bk_error *err)
+/* One output file into a row, its catalog figures from table (NULL: the default).
+ * BK_INCOMPLETE for a run that did not finish and BK_ERR_INVALID for an HDF5 file that is no
+ * bksim output or has no such table: each is left out, with a note. */
+static int read_run(summary *s, const char *dir, const char *name, const char *table,
+                    const bk_stats_options *opt, bk_error *err)
 {
     char *path = join_path(dir, name);
     if (!path)
@@ -250,7 +270,7 @@ static int read_run(summary *s, const char *dir, const char *name, const bk_stat
     for (int f = 0; f < N_FIGURES; ++f)
         run.figure[f] = NAN;
     char *version = NULL, *overrides = NULL;
-    int has_events = 0;
+    int has_catalog = 0;
     if (rc == BK_OK) {
         version = bk_h5_read_string_attr(file, "version");
         if (!version)
@@ -263,8 +283,12 @@ static int read_run(summary *s, const char *dir, const char *name, const bk_stat
         run.host = bk_h5_read_string_attr(file, "host");
         run.figure[FIG_SEED] = numeric_attr(file, "seed");
         overrides = bk_h5_read_string_attr(file, "overrides");
-        has_events = H5Lexists(file, "events", H5P_DEFAULT) > 0;
-        if (!has_events && H5Lexists(file, "v", H5P_DEFAULT) > 0)
+        has_catalog = table ? link_exists(file, table)
+                            : link_exists(file, BK_CATALOG_DEFAULT_TABLE) ||
+                                  link_exists(file, BK_CATALOG_FALLBACK_TABLE);
+        if (table && !has_catalog)
+            rc = BK_FAIL(err, BK_ERR_INVALID, "%s: no /%s table (--table %s)", path, table, table);
+        else if (!has_catalog && H5Lexists(file, "v", H5P_DEFAULT) > 0)
             rc = series_peak_slip_rate(file, path, &run, err);
         if (H5Lexists(file, "stats", H5P_DEFAULT) > 0 &&
             (stats = H5Gopen2(file, "stats", H5P_DEFAULT)) >= 0) {
@@ -274,8 +298,8 @@ static int read_run(summary *s, const char *dir, const char *name, const bk_stat
         }
     }
     CLOSE_IDS(rc == BK_OK ? 0 : -1, stats, file);
-    if (rc == BK_OK && has_events)
-        rc = catalog_figures(path, opt, &run, err);
+    if (rc == BK_OK && has_catalog)
+        rc = catalog_figures(path, table, opt, &run, err);
     if (rc == BK_OK && !(run.file = strdup(name)))
         rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
     /* Last: a run left out adds no key column. */
@@ -298,7 +322,7 @@ static int read_run(summary *s, const char *dir, const char *name, const bk_stat
 
 /* ------------------------------------------------------------------ columns --- */
 
-enum { TEXT_FILE, TEXT_POINT, TEXT_METHOD, TEXT_HOST };
+enum { TEXT_FILE, TEXT_POINT, TEXT_METHOD, TEXT_HOST, TEXT_CATALOG };
 
 typedef struct column {
     const char *name;
@@ -346,7 +370,7 @@ static const char *row_text(const run_row *run, const column *c)
 {
     if (c->key >= 0)
         return (size_t)c->key < run->n_values ? run->values[c->key] : NULL;
-    const char *texts[] = {run->file, run->point, run->method, run->host};
+    const char *texts[] = {run->file, run->point, run->method, run->host, run->catalog};
     return texts[c->field];
 }
 
@@ -360,14 +384,15 @@ static double row_number(const run_row *run, const column *c)
 }
 
 /* file, point, one column per key (numeric when every value given is a number), the
- * figures, method, host.  *n_columns set; NULL when out of memory. */
+ * figures, method, host, catalog (last: a column added later goes at the end).  *n_columns
+ * set; NULL when out of memory. */
 static column *make_columns(const summary *s, size_t *n_columns)
 {
-    size_t n = 2 + s->n_keys + N_FIGURES + 2, k = 0;
+    size_t n = 2 + s->n_keys + N_FIGURES + 3, k = 0;
     column *cols = calloc(n, sizeof *cols);
     if (!cols)
         return NULL;
-    static const char *const text_names[] = {"file", "point", "method", "host"};
+    static const char *const text_names[] = {"file", "point", "method", "host", "catalog"};
     for (int f = TEXT_FILE; f <= TEXT_POINT; ++f)
         cols[k++] = (column){text_names[f], "-", 1, -1, -1, f, 0, 0};
     for (size_t key = 0; key < s->n_keys; ++key) {
@@ -381,7 +406,7 @@ static column *make_columns(const summary *s, size_t *n_columns)
     }
     for (int f = 0; f < N_FIGURES; ++f)
         cols[k++] = (column){figures[f].name, figures[f].unit, 0, -1, f, 0, 0, 0};
-    for (int f = TEXT_METHOD; f <= TEXT_HOST; ++f)
+    for (int f = TEXT_METHOD; f <= TEXT_CATALOG; ++f)
         cols[k++] = (column){text_names[f], "-", 1, -1, -1, f, 0, 0};
     *n_columns = k;
     return cols;
@@ -417,7 +442,8 @@ static int write_tsv(const summary *s, column *cols, size_t n_cols, const char *
         return BK_FAIL(err, BK_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
     char *units = units_text(cols, n_cols, 0);
     fprintf(out, "# bksim summary of %s: %zu finished runs, one per row; key columns hold each "
-            "run's --set values; units: %s\n", dir, s->n_runs, units ? units : "?");
+            "run's --set values; events and the figures after it count the rows of the table in "
+            "column catalog (ruptures by default); units: %s\n", dir, s->n_runs, units ? units : "?");
     free(units);
     for (size_t c = 0; c < n_cols; ++c)
         fprintf(out, "%s%s", c ? "\t" : "", cols[c].name);
@@ -487,7 +513,8 @@ static int write_table(const summary *s, column *cols, size_t n_cols, const char
     char description[512];
     snprintf(description, sizeof description,
              "bksim summary of %s: one row per finished run, its --set values and headline "
-             "figures (NaN where a run has none)", dir);
+             "figures (NaN where a run has none; the catalog figures from the table in column "
+             "catalog)", dir);
     if (ok >= 0)
         file = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     if (file >= 0)
@@ -543,12 +570,17 @@ static int write_atomically(const summary *s, column *cols, size_t n_cols, const
     return rc;
 }
 
-int bk_h5_summary(const char *dir, const bk_stats_options *opt, FILE *notes, size_t *n_runs,
-                  bk_error *err)
+int bk_h5_summary(const char *dir, const char *table, const bk_stats_options *opt, FILE *notes,
+                  size_t *n_runs, bk_error *err)
 {
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
     if (n_runs)
         *n_runs = 0;
+    if (table && table[0] == '/')
+        ++table;
+    if (table && !*table)
+        return BK_FAIL(err, BK_ERR_INVALID, "%s: no table name given (ruptures, events, ...)",
+                       dir ? dir : "(null)");
     DIR *d = dir ? opendir(dir) : NULL;
     if (!d)
         return BK_FAIL(err, BK_ERR_IO, "%s: cannot read the directory: %s", dir ? dir : "(null)",
@@ -561,7 +593,7 @@ int bk_h5_summary(const char *dir, const bk_stats_options *opt, FILE *notes, siz
         if (!is_run_output(entry->d_name))
             continue;
         bk_error why = {0};
-        int read = read_run(&s, dir, entry->d_name, opt, &why);
+        int read = read_run(&s, dir, entry->d_name, table, opt, &why);
         if (read == BK_ERR_NOMEM) {
             *err = why;
             rc = read;
@@ -573,8 +605,16 @@ int bk_h5_summary(const char *dir, const bk_stats_options *opt, FILE *notes, siz
     }
     closedir(d);
     if (rc == BK_OK && s.n_runs == 0)
-        rc = BK_FAIL(err, BK_ERR_INVALID, "%s: no finished bksim output (*.h5) to summarise%s", dir,
+        rc = BK_FAIL(err, BK_ERR_INVALID, "%s: no finished bksim output (*.h5)%s%s%s to summarise%s", dir,
+                     table ? " with a /" : "", table ? table : "", table ? " table" : "",
                      left_out ? " (see the notes above)" : "");
+    size_t fell_back = 0;
+    for (size_t r = 0; r < s.n_runs; ++r)
+        fell_back += s.runs[r].fallback != 0;
+    if (rc == BK_OK && fell_back && notes)
+        fprintf(notes, "bksim summary: %zu of %zu runs have no /%s table: their catalog figures are "
+                "from /%s (column catalog)\n", fell_back, s.n_runs, BK_CATALOG_DEFAULT_TABLE,
+                BK_CATALOG_FALLBACK_TABLE);
     size_t n_cols = 0;
     column *cols = NULL;
     if (rc == BK_OK) {

@@ -51,6 +51,62 @@ void assert_same_output(const char *a, const char *b)
         assert_same_event(&ea[k], &eb[k]);
     free(ea);
     free(eb);
+    assert_same_ruptures(a, b);
+}
+
+/* Field by field (the structs have padding), bit for bit. */
+#define SAME_BITS(x, y) assert_memory_equal(&(x), &(y), sizeof(x))
+
+void assert_same_ruptures(const char *a, const char *b)
+{
+    bk_error err = {0};
+    bk_rupture *ra = NULL, *rb = NULL;
+    size_t na = 0, nb = 0;
+    int in_a = bk_h5_read_ruptures(a, &ra, &na, &err) == BK_OK;
+    int in_b = bk_h5_read_ruptures(b, &rb, &nb, &err) == BK_OK;
+    assert_int_equal(in_a, in_b);
+    assert_int_equal(na, nb);
+    for (size_t k = 0; k < na; ++k) {
+        SAME_BITS(ra[k].t_start, rb[k].t_start);
+        SAME_BITS(ra[k].t_end, rb[k].t_end);
+        SAME_BITS(ra[k].potency, rb[k].potency);
+        SAME_BITS(ra[k].magnitude, rb[k].magnitude);
+        SAME_BITS(ra[k].max_slip_rate, rb[k].max_slip_rate);
+        SAME_BITS(ra[k].stress_drop, rb[k].stress_drop);
+        SAME_BITS(ra[k].duration, rb[k].duration);
+        SAME_BITS(ra[k].front_speed_left, rb[k].front_speed_left);
+        SAME_BITS(ra[k].front_speed_right, rb[k].front_speed_right);
+        assert_true(ra[k].first_block == rb[k].first_block && ra[k].n_blocks == rb[k].n_blocks &&
+                    ra[k].left == rb[k].left && ra[k].right == rb[k].right &&
+                    ra[k].n_episodes == rb[k].n_episodes && ra[k].complete == rb[k].complete);
+    }
+    free(ra);
+    free(rb);
+    bk_rupture_block *ba = NULL, *bb = NULL;
+    in_a = bk_h5_read_rupture_blocks(a, &ba, &na, &err) == BK_OK;
+    in_b = bk_h5_read_rupture_blocks(b, &bb, &nb, &err) == BK_OK;
+    assert_int_equal(in_a, in_b);
+    assert_int_equal(na, nb);
+    for (size_t k = 0; k < na; ++k) {
+        SAME_BITS(ba[k].t_onset, bb[k].t_onset);
+        SAME_BITS(ba[k].t_stop, bb[k].t_stop);
+        SAME_BITS(ba[k].slip, bb[k].slip);
+        assert_true(ba[k].rupture == bb[k].rupture && ba[k].block == bb[k].block);
+    }
+    free(ba);
+    free(bb);
+    bk_rupture_rate *qa = NULL, *qb = NULL;
+    in_a = bk_h5_read_rupture_rate(a, &qa, &na, &err) == BK_OK;
+    in_b = bk_h5_read_rupture_rate(b, &qb, &nb, &err) == BK_OK;
+    assert_int_equal(in_a, in_b);
+    assert_int_equal(na, nb);
+    for (size_t k = 0; k < na; ++k) {
+        SAME_BITS(qa[k].t, qb[k].t);
+        SAME_BITS(qa[k].rate, qb[k].rate);
+        assert_true(qa[k].rupture == qb[k].rupture);
+    }
+    free(qa);
+    free(qb);
 }
 
 void assert_same_event(const bk_event *a, const bk_event *b)
