@@ -25,9 +25,10 @@ scripts/plot_summary.sh -o docs/sweep_mu_d.png --xlabel 'μ_d' --ylabel 'period 
     --y2label 'peak slip rate (m/s)' \
     --title 'paper case A (Coulomb), one run per μ_d: period and peak slip rate' \
     "$dir/mu_d" friction.mu_d mean_recurrence peak_slip_rate
-# 6,000 time units, the first 1,000 (spin-up from a nearly uniform ring) left out.
+# 6,000 time units, the first 1,000 (spin-up from a nearly uniform ring) left out; the
+# statistics need the rupture catalog, not the moment-rate functions.
 scripts/sweep.sh -j "$jobs" -o "$dir/coupling" configs/chains/carlson_langer_100.ini \
-    model.coupling_stiffness=4,9,16,25,36,49,64,100,144 run.t_end=6000 \
+    model.coupling_stiffness=4,9,16,25,36,49,64,100,144 run.t_end=6000 catalog.rupture_rate=false \
     output.checkpoint_interval=500
 "$bksim" summary "$dir/coupling" --from 1000
 scripts/plot_summary.sh -o docs/sweep_coupling_b.png --x-transform 'sqrt(x)' \

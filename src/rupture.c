@@ -822,7 +822,7 @@ static int build(bk_ruptures *b, int32_t r, bk_rupture *out, size_t *n_blocks_ou
             rup.first_block = ep->block;
         }
         rup.t_end = fmax(rup.t_end, ep->t_stop);
-        rup.potency += fabs(ep->x_stop - ep->x_onset);
+        rup.potency += ep->x_stop - ep->x_onset; /* signed: a slip back takes potency away */
         rup.max_slip_rate = fmax(rup.max_slip_rate, ep->peak);
         if (k == 0 || ep->block != b->episodes[order[k - 1]].block) {
             blocks[j] = (bk_rupture_block){.rupture = b->ruptures, .block = ep->block, .t_onset = ep->t_onset};
@@ -834,13 +834,12 @@ static int build(bk_ruptures *b, int32_t r, bk_rupture *out, size_t *n_blocks_ou
         if (k + 1 == n_ep || b->episodes[order[k + 1]].block != ep->block)
             drop -= ep->f_stop;
     }
-    /* slip: the last stop minus the first onset of each block. */
+    /* slip: each block's episodes summed (between them another rupture may move it). */
     for (k = 0, j = 0; k < n_ep; ++k) {
         const episode *ep = &b->episodes[order[k]];
         if (k == 0 || ep->block != b->episodes[order[k - 1]].block)
-            blocks[j++].slip = -ep->x_onset;
-        if (k + 1 == n_ep || b->episodes[order[k + 1]].block != ep->block)
-            blocks[j - 1].slip += ep->x_stop;
+            blocks[j++].slip = 0.0;
+        blocks[j - 1].slip += ep->x_stop - ep->x_onset;
     }
     rup.n_blocks = (int32_t)n_blocks;
     rup.n_episodes = (int32_t)n_ep;

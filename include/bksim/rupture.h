@@ -31,8 +31,10 @@ typedef struct bk_rupture {
                                 (left > right when it wraps); on a lattice the bounding
                                 box's top-left and bottom-right corners */
     int32_t n_episodes;
-    double potency;          /* m: sum over its episodes of |x at stop - x at onset| */
-    double magnitude;        /* (2/3) log10(potency / 1 m) + magnitude_offset; -inf if 0 */
+    double potency;          /* m: sum over its episodes of x at stop - x at onset (a slip back
+                                counts negative: the moment-rate function, a sum of |v|,
+                                integrates to the potency when no episode slips back) */
+    double magnitude;        /* (2/3) log10(potency / 1 m) + magnitude_offset; -inf if <= 0 */
     double max_slip_rate;    /* m/s: the largest |v| of any of its blocks while slipping */
     double stress_drop;      /* N: mean over its blocks of the applied force at the first
                                 onset minus that at the last stop */
@@ -47,7 +49,9 @@ typedef struct bk_rupture_block {
     int32_t block;
     double t_onset;          /* s: its first onset in the rupture (the front's arrival) */
     double t_stop;           /* s: its last stop (the run's end if still slipping) */
-    double slip;             /* m: x at the last stop minus x at the first onset */
+    double slip;             /* m: its net displacement while slipping in the rupture: the sum
+                                over its episodes of x at stop - x at onset (another rupture's
+                                slip of the block in between is not counted) */
 } bk_rupture_block;
 
 /* One sample of a rupture's moment-rate (potency-rate) function: the sum over its slipping
