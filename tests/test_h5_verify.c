@@ -3,6 +3,7 @@
  * inside a chunk, and files from before the "datasets" record. */
 #include "bk_test.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -172,6 +173,40 @@ static void test_verify_events(void **state)
     expect_damaged(f->path, "/events rows 0..1 cannot be read");
 }
 
+/* The rupture tables: each row as bksim writes it, blocks and rate rows of existing ruptures
+ * in order, and as many block rows as the ruptures have blocks. */
+static void test_verify_ruptures(void **state)
+{
+    output_fixture *f = *state;
+    const bk_rupture ok = {.t_start = 0.01, .t_end = 0.05, .first_block = 1, .n_blocks = 2, .left = 1,
+                           .right = 2, .n_episodes = 2, .potency = 3e-4, .magnitude = -2.35,
+                           .max_slip_rate = 0.02, .stress_drop = 1.0, .duration = 0.05 - 0.01,
+                           .front_speed_left = NAN, .front_speed_right = NAN, .complete = 1};
+    const bk_rupture_block blocks[2] = {{0, 1, 0.01, 0.05, 2e-4}, {0, 2, 0.02, 0.04, 1e-4}};
+    const bk_rupture_rate rate[3] = {{0, 0.01, 0.0}, {0, 0.03, 0.02}, {0, 0.05, 0.0}};
+    write_small_with_rupture(f->path, &ok, blocks, 2, rate, 3);
+    bk_error err = {0};
+    assert_int_equal(bk_h5_verify(f->path, &err), BK_OK);
+
+    bk_rupture outside = ok;
+    outside.n_blocks = 4; /* of 3 blocks */
+    write_small_with_rupture(f->path, &outside, blocks, 2, rate, 3);
+    expect_damaged(f->path, "/ruptures row 0 has values no rupture has");
+    bk_rupture stale = ok;
+    stale.duration = 0.03; /* not t_end - t_start */
+    write_small_with_rupture(f->path, &stale, blocks, 2, rate, 3);
+    expect_damaged(f->path, "/ruptures row 0 has values no rupture has");
+    write_small_with_rupture(f->path, &ok, blocks, 1, rate, 3);
+    expect_damaged(f->path, "/rupture_blocks has 1 rows, the ruptures of /ruptures 2 blocks");
+    bk_rupture_block later[2] = {blocks[0], blocks[1]};
+    later[1].rupture = 1; /* a rupture that is not there */
+    write_small_with_rupture(f->path, &ok, later, 2, rate, 3);
+    expect_damaged(f->path, "/rupture_blocks row 1: rupture 1 (of 1, in order)");
+    bk_rupture_rate back[3] = {rate[0], rate[2], rate[1]};
+    write_small_with_rupture(f->path, &ok, blocks, 2, back, 3);
+    expect_damaged(f->path, "/rupture_rate row 2: rupture 0 (of 1), t 0.029999999999999999 s");
+}
+
 /* Bytes damaged inside a chunk: the chunk's Fletcher32 checksum fails the read. */
 static void test_verify_flipped_chunk_bytes(void **state)
 {
@@ -216,6 +251,7 @@ int main(void)
         OUTPUT_TEST(test_verify_required_datasets),
         OUTPUT_TEST(test_verify_transitions),
         OUTPUT_TEST(test_verify_events),
+        OUTPUT_TEST(test_verify_ruptures),
         OUTPUT_TEST(test_verify_flipped_chunk_bytes),
         OUTPUT_TEST(test_verify_file_without_dataset_record),
     };

@@ -32,7 +32,9 @@ int bk_h5_info_blocks(const char *path, FILE *out, int per_block, bk_error *err)
  * chunk's Fletcher32 checksum checked), a block of rows at a time: all finite, /mode in
  * {-1, 0, 1}, /event in {0, 1}, /time strictly increasing, t_reached its last value and, for
  * a complete run, /time ending at t_end; /transitions in time order within the run, of
- * existing blocks between valid modes; and a /checkpoint verifying as a restart requires.
+ * existing blocks between valid modes; /events and /ruptures rows as bksim writes them,
+ * /rupture_blocks and /rupture_rate rows of existing ruptures in order, as many block rows as
+ * the ruptures have blocks; and a /checkpoint verifying as a restart requires.
  * Same returns as bk_h5_info. */
 int bk_h5_verify(const char *path, bk_error *err);
 

@@ -226,6 +226,122 @@ static int scan_events(hid_t file, const verify_ctx *v, bk_error *err)
     return rc;
 }
 
+/* ------------------------------------------------------------ the rupture tables --- */
+
+typedef struct rupture_check {
+    const verify_ctx *v;
+    long long ruptures;       /* rows of /ruptures */
+    long long limit;          /* the largest rupture a block or rate row may name: the last row,
+                                 or in a run cut short the one whose row was still to come */
+    long long block_rows;     /* the sum of their n_blocks: the rows /rupture_blocks must have */
+    long long last;           /* rupture of the row before (blocks and rate), -1 at first */
+    double t_last;            /* s, t of the rate row before */
+} rupture_check;
+
+static int check_rupture(const void *record, unsigned long long row, rupture_check *c, bk_error *err)
+{
+    const bk_rupture *r = record;
+    long long n = c->v->n_blocks;
+    int blocks_ok = r->first_block >= 0 && r->first_block < n && r->left >= 0 && r->left < n && r->right >= 0 &&
+                    r->right < n && r->n_blocks >= 1 && r->n_blocks <= n && r->n_episodes >= r->n_blocks &&
+                    (r->complete == 0 || r->complete == 1);
+    if (!isfinite(r->t_start) || !(r->t_end >= r->t_start) || !isfinite(r->t_end) || !isfinite(r->potency) ||
+        isnan(r->magnitude) || !(r->max_slip_rate >= 0.0) || !isfinite(r->stress_drop) ||
+        !(r->duration == r->t_end - r->t_start) || !blocks_ok)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /ruptures row %llu has values no rupture has "
+                       "(t_start %g, t_end %g, duration %g, potency %g, first_block %d, n_blocks %d, "
+                       "n_episodes %d, complete %d; blocks 0..%lld)", c->v->path, row, r->t_start, r->t_end,
+                       r->duration, r->potency, (int)r->first_block, (int)r->n_blocks, (int)r->n_episodes,
+                       (int)r->complete, n - 1);
+    c->block_rows += r->n_blocks;
+    return BK_OK;
+}
+
+static int check_rupture_block(const void *record, unsigned long long row, rupture_check *c, bk_error *err)
+{
+    const bk_rupture_block *b = record;
+    if (b->rupture < 0 || b->rupture > c->limit || b->rupture < c->last || b->block < 0 ||
+        b->block >= c->v->n_blocks || !isfinite(b->t_onset) || !(b->t_stop >= b->t_onset) || !isfinite(b->slip))
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /rupture_blocks row %llu: rupture %lld (of %lld, "
+                       "in order), block %d, t_onset %g, t_stop %g, slip %g", c->v->path, row,
+                       (long long)b->rupture, c->ruptures, (int)b->block, b->t_onset, b->t_stop, b->slip);
+    c->last = b->rupture;
+    return BK_OK;
+}
+
+static int check_rupture_rate(const void *record, unsigned long long row, rupture_check *c, bk_error *err)
+{
+    const bk_rupture_rate *q = record;
+    int in_order = q->rupture > c->last || (q->rupture == c->last && q->t > c->t_last);
+    if (q->rupture < 0 || q->rupture > c->limit || !in_order || !isfinite(q->t) || !(q->rate >= 0.0) ||
+        !isfinite(q->rate))
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /rupture_rate row %llu: rupture %lld (of %lld), "
+                       "t %.17g s (after %.17g s), rate %g m/s", c->v->path, row, (long long)q->rupture,
+                       c->ruptures, q->t, c->t_last, q->rate);
+    c->last = q->rupture;
+    c->t_last = q->t;
+    return BK_OK;
+}
+
+/* Every row of a rupture table read (the chunk checksums), 4096 at a time, and checked;
+ * *rows gets the table's length. */
+static int scan_rupture_table(hid_t file, bk_h5_table_kind kind, rupture_check *c,
+                              int (*check)(const void *, unsigned long long, rupture_check *, bk_error *),
+                              hsize_t *rows, bk_error *err)
+{
+    const char *name = bk_h5_tables[kind].name;
+    size_t size = bk_h5_tables[kind].struct_bytes;
+    const hsize_t slab = 4096;
+    hid_t dset = H5Dopen2(file, name, H5P_DEFAULT);
+    hid_t mem = bk_h5_table_type(kind, BK_H5_RECORD_STRUCT);
+    hid_t space = dset < 0 ? H5I_INVALID_HID : H5Dget_space(dset);
+    unsigned char *buf = malloc((size_t)slab * size);
+    int rc = BK_OK;
+    *rows = 0;
+    if (dset < 0 || mem < 0 || space < 0 || H5Sget_simple_extent_ndims(space) != 1 ||
+        H5Sget_simple_extent_dims(space, rows, NULL) < 0)
+        rc = H5_DAMAGED(err, "%s: damaged: /%s cannot be opened", c->v->path, name);
+    else if (!buf)
+        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory checking /%s", c->v->path, name);
+    for (hsize_t start = 0; rc == BK_OK && start < *rows; start += slab) {
+        hsize_t n = *rows - start < slab ? *rows - start : slab;
+        if (bk_h5_read_block(dset, 1, start, n, 0, 1, mem, buf) < 0) {
+            rc = H5_DAMAGED(err, "%s: damaged: /%s rows %llu..%llu cannot be read", c->v->path, name,
+                            (unsigned long long)start, (unsigned long long)(start + n - 1));
+            break;
+        }
+        for (hsize_t k = 0; rc == BK_OK && k < n; ++k)
+            rc = check(buf + (size_t)k * size, (unsigned long long)(start + k), c, err);
+    }
+    free(buf);
+    CLOSE_IDS(rc == BK_OK ? 0 : -1, space, mem, dset);
+    return rc;
+}
+
+/* The three tables of the rupture catalog: each row as bksim writes it, the blocks and rate
+ * rows of existing ruptures in rupture order, and as many block rows as the ruptures have
+ * blocks.  A rupture's blocks and rate go out before its row, so a run cut short may hold
+ * those of one rupture more. */
+static int scan_ruptures(hid_t file, const verify_ctx *v, bk_error *err)
+{
+    rupture_check c = {v, 0, 0, 0, -1, -INFINITY};
+    hsize_t rows = 0, block_rows = 0, rate_rows = 0;
+    int rc = scan_rupture_table(file, BK_TABLE_RUPTURES, &c, check_rupture, &rows, err);
+    c.ruptures = (long long)rows;
+    c.limit = v->complete ? c.ruptures - 1 : c.ruptures;
+    if (rc == BK_OK && H5Lexists(file, "rupture_blocks", H5P_DEFAULT) <= 0)
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /ruptures without /rupture_blocks", v->path);
+    if (rc == BK_OK)
+        rc = scan_rupture_table(file, BK_TABLE_RUPTURE_BLOCKS, &c, check_rupture_block, &block_rows, err);
+    if (rc == BK_OK && (v->complete ? (long long)block_rows != c.block_rows : (long long)block_rows < c.block_rows))
+        rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: /rupture_blocks has %llu rows, the ruptures of "
+                     "/ruptures %lld blocks", v->path, (unsigned long long)block_rows, c.block_rows);
+    c.last = -1;
+    if (rc == BK_OK && H5Lexists(file, "rupture_rate", H5P_DEFAULT) > 0)
+        rc = scan_rupture_table(file, BK_TABLE_RUPTURE_RATE, &c, check_rupture_rate, &rate_rows, err);
+    return rc;
+}
+
 /* The datasets a file must hold: those its writer recorded, or for a file written before
  * that record, those its stored config selects (time, driver, event if it does not load).
  * Malloc'ed, comma-separated; NULL when out of memory. */
@@ -310,6 +426,8 @@ int bk_h5_verify_open(hid_t file, const char *path, bk_error *err)
         rc = scan_transitions(file, &v, err);
     if (rc == BK_OK && H5Lexists(file, "events", H5P_DEFAULT) > 0)
         rc = scan_events(file, &v, err);
+    if (rc == BK_OK && H5Lexists(file, "ruptures", H5P_DEFAULT) > 0)
+        rc = scan_ruptures(file, &v, err);
     if (rc == BK_OK && H5Lexists(file, "checkpoint", H5P_DEFAULT) > 0) {
         bk_h5_slot slot;
         bk_error why = {0};

@@ -220,6 +220,30 @@ void write_small_with_events(const char *path, const bk_transition *transitions,
     bk_config_free(c);
 }
 
+void write_small_with_rupture(const char *path, const bk_rupture *rupture, const bk_rupture_block *blocks,
+                              size_t n_blocks, const bk_rupture_rate *rate, size_t n_rate)
+{
+    bk_config *c = synthetic_config(3, BK_FIELD_ALL, 0, 0);
+    c->t_end = 0.2;
+    c->output.events = 1;
+    c->catalog.rupture_rate = 1;
+    bk_h5_writer *w;
+    bk_error err;
+    assert_int_equal(bk_h5_writer_open(&w, c, path, &err), BK_OK);
+    bk_sink sink = bk_h5_writer_sink(w);
+    double x[3] = {0.1, 0.2, 0.3}, v[3] = {0}, fr[3] = {1, 2, 3}, cof[3] = {0.6, 0.6, 0.6};
+    int8_t mode[3] = {0, 1, -1};
+    for (int r = 0; r < 3; ++r) {
+        bk_sample sample = {.t = 0.1 * r, .driver = 0.7 * r, .n_blocks = 3, .x = x, .v = v,
+                            .friction = fr, .cof = cof, .mode = mode};
+        assert_int_equal(sink.sample(sink.self, &sample, &err), BK_OK);
+    }
+    assert_int_equal(sink.rupture(sink.self, rupture, blocks, n_blocks, rate, n_rate, &err), BK_OK);
+    bk_run_stats stats = example_stats();
+    assert_int_equal(bk_h5_writer_finish(w, &stats, &err), BK_OK);
+    bk_config_free(c);
+}
+
 void check_series(const char *path, const char *name, size_t rows, size_t cols,
                          int which)
 {

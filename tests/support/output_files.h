@@ -43,6 +43,10 @@ void write_small_with(const char *path, const bk_transition *transitions, size_t
 void write_small_with_events(const char *path, const bk_transition *transitions, size_t n,
                              const bk_event *events, size_t n_events);
 
+/* The same with /events empty and one rupture: its row, its blocks and its rate rows. */
+void write_small_with_rupture(const char *path, const bk_rupture *rupture, const bk_rupture_block *blocks,
+                              size_t n_blocks, const bk_rupture_rate *rate, size_t n_rate);
+
 /* Series `name` of path holds rows x cols values of series `which` (-1: row_time). */
 void check_series(const char *path, const char *name, size_t rows, size_t cols, int which);
 /* bk_h5_verify calls path damaged with a message naming path and containing needle, and
