@@ -271,7 +271,7 @@ int bk_run_ruptures_finish(run_ctx *ctx, double t);
 /* The builder's state into a checkpoint's catalog part (nothing without ruptures). */
 int bk_run_ruptures_save(run_ctx *ctx, bk_catalog_state *state);
 /* Speed samples of an island just (re)started, and of its last step. */
-void bk_run_ruptures_island_start(run_ctx *ctx, const run_island *isl);
+int bk_run_ruptures_island_start(run_ctx *ctx, const run_island *isl);
 int bk_run_ruptures_island_step(run_ctx *ctx, run_island *isl);
 
 /* ---- run_books.c ---- */

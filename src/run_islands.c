@@ -270,7 +270,8 @@ int bk_run_start_island(run_ctx *ctx, size_t id, double t)
     isl->pending = 0;
     isl->t_reached = t;
     bk_run_catalog_island_start(ctx, isl);
-    bk_run_ruptures_island_start(ctx, isl);
+    if ((rc = bk_run_ruptures_island_start(ctx, isl)) != BK_OK)
+        return rc;
     bk_heap_set(&ctx->island_queue, id, t);
     return BK_OK;
 }

@@ -12,7 +12,9 @@
  * changing sign from + to -) whose cubic estimate could raise the episode's largest speed is
  * located on the dense output (Brent) and sampled too: the largest slip rate is the dense
  * output's, exact for the exact stepper.  An island restarted at t (a merge, a checkpoint)
- * samples its blocks at t again, which drops samples its discarded last step took past t. */
+ * samples its blocks at t again, which drops samples its discarded last step took past t;
+ * so samples before a step's start are settled (bk_ruptures_settle), and the builder may sum
+ * them into the rupture's rate as it goes. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -140,19 +142,21 @@ int bk_run_ruptures_save(run_ctx *ctx, bk_catalog_state *state)
     return BK_OK;
 }
 
-void bk_run_ruptures_island_start(run_ctx *ctx, const run_island *isl)
+int bk_run_ruptures_island_start(run_ctx *ctx, const run_island *isl)
 {
     if (!ctx->ruptures)
-        return;
+        return BK_OK;
     const bk_scene *scene = &ctx->scene;
     const bk_island *island = &isl->island;
     for (size_t k = 0; k < island->n_active; ++k) {
         size_t i = island->active[k];
         ctx->rupture_v[i] = isl->y[scene->slot[i] + 1];
         ctx->rupture_a[i] = bk_run_speed_rate(isl, i, island->t_ref, isl->y);
-        /* Only a memory failure can fail, and the next step's sample reports it. */
-        (void)bk_ruptures_sample(ctx->ruptures, i, island->t_ref, fabs(ctx->rupture_v[i]));
+        if (bk_ruptures_sample(ctx->ruptures, i, island->t_ref, fabs(ctx->rupture_v[i])) != BK_OK)
+            return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the rupture catalog at t = %.17g s",
+                           island->t_ref);
     }
+    return BK_OK;
 }
 
 /* A slipping block's step: its speed and d|v|/dt at the step's end, and its interior peak. */
