@@ -173,19 +173,10 @@ int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl)
     const bk_scene *scene = &ctx->scene;
     const bk_island *island = &isl->island;
     double lo, hi;
-    ctx->backend->last_step(isl->solver, &lo, &hi);
-    hi = isl->t_reached;
-    const double *y = isl->y;
-    /* A stop found inside the step ends the trajectory there. */
-    if (isl->pending && isl->t_event < hi) {
-        hi = isl->t_event;
-        int rc = ctx->backend->interpolate(isl->solver, hi, isl->y_probe, ctx->err);
-        if (rc != BK_OK)
-            return rc;
-        y = isl->y_probe;
-    }
-    if (lo < island->t_ref)
-        lo = island->t_ref;
+    const double *y;
+    int rc = bk_run_last_step(ctx, isl, &lo, &hi, &y);
+    if (rc != BK_OK)
+        return rc;
     double fastest = 0.0, best_estimate = -1.0;
     size_t best = SIZE_MAX;
     for (size_t k = 0; k < island->n_active; ++k) {
@@ -213,7 +204,7 @@ int bk_run_catalog_island_step(run_ctx *ctx, run_island *isl)
         t_peak = bk_run_zero_after(ctx, &fn, lo, hi);
     if (probe.status != BK_OK)
         return probe.status;
-    int rc = ctx->backend->interpolate(isl->solver, t_peak, isl->y_probe, ctx->err);
+    rc = ctx->backend->interpolate(isl->solver, t_peak, isl->y_probe, ctx->err);
     if (rc != BK_OK)
         return rc;
     bk_catalog_slip_rate(ctx->catalog, isl->y_probe[scene->slot[best] + 1]);

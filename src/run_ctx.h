@@ -300,6 +300,10 @@ typedef struct bk_block_probe {
 } bk_block_probe;
 /* The island's vector at t (in isl->y_probe); NULL, with status set, when the back-end fails. */
 const double *bk_run_probe_state(bk_block_probe *probe, double t);
+/* The island's last step as its trajectory stands: [*lo, *hi] from its (re)start on, ended
+ * by an event found inside it, and the island's vector at *hi (*y: isl->y, or isl->y_probe
+ * interpolated there). */
+int bk_run_last_step(run_ctx *ctx, run_island *isl, double *lo, double *hi, const double **y);
 /* d|v|/dt of slipping block i for the island's vector y at t (from rest: along its mode). */
 double bk_run_speed_rate(const run_island *isl, size_t i, double t, const double *y);
 /* The same on the island's last-step interpolant (a bk_block_probe), for Brent. */

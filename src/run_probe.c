@@ -70,3 +70,21 @@ double bk_run_speed_rate_probe(double t, void *user)
     return y ? bk_run_speed_rate(p->isl, p->block, t, y) : 0.0;
 }
 
+
+int bk_run_last_step(run_ctx *ctx, run_island *isl, double *lo, double *hi, const double **y)
+{
+    ctx->backend->last_step(isl->solver, lo, hi);
+    *hi = isl->t_reached;
+    *y = isl->y;
+    /* A stop found inside the step ends the trajectory there. */
+    if (isl->pending && isl->t_event < *hi) {
+        *hi = isl->t_event;
+        int rc = ctx->backend->interpolate(isl->solver, *hi, isl->y_probe, ctx->err);
+        if (rc != BK_OK)
+            return rc;
+        *y = isl->y_probe;
+    }
+    if (*lo < isl->island.t_ref)
+        *lo = isl->island.t_ref;
+    return BK_OK;
+}

@@ -194,19 +194,10 @@ int bk_run_ruptures_island_step(run_ctx *ctx, run_island *isl)
     const bk_scene *scene = &ctx->scene;
     const bk_island *island = &isl->island;
     double lo, hi;
-    ctx->backend->last_step(isl->solver, &lo, &hi);
-    hi = isl->t_reached;
-    const double *y = isl->y;
-    /* A stop found inside the step ends the trajectory there. */
-    if (isl->pending && isl->t_event < hi) {
-        hi = isl->t_event;
-        int rc = ctx->backend->interpolate(isl->solver, hi, isl->y_probe, ctx->err);
-        if (rc != BK_OK)
-            return rc;
-        y = isl->y_probe;
-    }
-    if (lo < island->t_ref)
-        lo = island->t_ref;
+    const double *y;
+    int rc = bk_run_last_step(ctx, isl, &lo, &hi, &y);
+    if (rc != BK_OK)
+        return rc;
     block_step *steps = bk_grow_array(ctx->rupture_steps, &ctx->rupture_steps_capacity,
                                       island->n_active ? island->n_active : 1, sizeof *steps, 16);
     if (!steps)
@@ -247,7 +238,7 @@ int bk_run_ruptures_island_step(run_ctx *ctx, run_island *isl)
         double t_peak = bk_run_zero_after(ctx, &fn, lo, hi);
         if (probe.status != BK_OK)
             return probe.status;
-        int rc = ctx->backend->interpolate(isl->solver, t_peak, isl->y_probe, ctx->err);
+        rc = ctx->backend->interpolate(isl->solver, t_peak, isl->y_probe, ctx->err);
         if (rc != BK_OK)
             return rc;
         if (t_peak > lo && t_peak < hi) {
@@ -256,7 +247,7 @@ int bk_run_ruptures_island_step(run_ctx *ctx, run_island *isl)
         }
     }
     size_t count = pieces(ctx, steps, n, h);
-    int rc = BK_OK;
+    rc = BK_OK;
     for (size_t j = 1; j <= count && rc == BK_OK; ++j) {
         double t = j == count ? hi : lo + h * (double)j / (double)count;
         const double *yj = j == count ? y : NULL;

@@ -1,0 +1,271 @@
+/* The commands that read a run's output, for the bksim command line (cli/main.c dispatches):
+ * export (time series and tables as text), stats (a catalog's statistics) and summary (a
+ * sweep's table). */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bksim/bksim.h"
+#include "cli/cli.h"
+
+static const char *const export_help =
+    "usage: bksim export OUT.h5 [--datasets a,b,...] [--block I] [--transitions]\n"
+    "       bksim export OUT.h5 --events\n"
+    "       bksim export OUT.h5 --table NAME\n"
+    "\n"
+    "Prints whitespace-separated columns with a '#' header (names and units).\n"
+    "  --datasets LIST   comma-separated dataset names (default time,event,driver,x,v,\n"
+    "                    friction,cof,mode); per-block datasets give one column per block.\n"
+    "                    A transition instant is two rows at one time: event 2, the state\n"
+    "                    just before its transitions, then event 1, just after\n"
+    "  --block I         only block I (0-based) of the per-block datasets\n"
+    "  --transitions     print the /transitions table instead\n"
+    "  --events          print the event catalog /events instead, tab-separated: one row\n"
+    "                    per event, every field (t_start ... complete); on a ring\n"
+    "                    left > right when the extent wraps past block 0\n"
+    "  --table NAME      print any table of records as TSV, every field with its unit:\n"
+    "                    ruptures, rupture_blocks, rupture_rate (README \"Ruptures\"),\n"
+    "                    events, transitions\n";
+
+static const char *const stats_help =
+    "usage: bksim stats FILE [--table NAME] [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
+    "                        [--json] [--tsv DIR]\n"
+    "\n"
+    "Statistics of an earthquake catalog in the HDF5 file FILE (a table with at least\n"
+    "t_start and magnitude): magnitude-frequency distribution, completeness magnitude Mc,\n"
+    "b-value (Aki-Utsu maximum likelihood, Shi & Bolt error), potency exponent, event\n"
+    "sizes, recurrence intervals, and a KS test of the two halves of the run.  Events still\n"
+    "running at the end (complete = 0) are left out.  The catalog is the rupture catalog\n"
+    "/ruptures (connected slip episodes: one row per rupture); a file without it (an older\n"
+    "bksim output, another program's catalog) falls back to /events, and the report says so\n"
+    "(JSON: \"table\", \"table_fallback\").\n"
+    "  --table NAME      the catalog table: events (the time-window catalog: maximal\n"
+    "                    intervals during which some block slips), ruptures, or any 1-D\n"
+    "                    table of FILE with fields t_start and magnitude; no fallback\n"
+    "  --mc auto|VALUE   completeness magnitude: maximum curvature + 0.2 (auto, the\n"
+    "                    default) or VALUE, a multiple of the bin width\n"
+    "  --bin DM          magnitude bin width, 0 < DM <= 10 (default 0.1)\n"
+    "  --from T, --to T  only events starting at t >= T, t < T (s): leave a spin-up out;\n"
+    "                    rates, recurrence and the KS test use the window's span\n"
+    "  --json            print one JSON object instead of the text report\n"
+    "  --tsv DIR         also write tables for gnuplot to DIR (created if missing): mfd.tsv,\n"
+    "                    gr_fit.tsv, sizes.tsv, sizes_log2.tsv, intervals.tsv,\n"
+    "                    potency_ccdf.tsv\n";
+
+static const char *const summary_help =
+    "usage: bksim summary DIR [--table NAME] [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
+    "\n"
+    "One row per finished run (complete *.h5) in DIR, sorted by file name: file, point (the\n"
+    "sweep's grid point), a column per --set key of the runs (named by the key: the run's\n"
+    "value), then events, mean_recurrence (s), largest_magnitude, largest_event_blocks,\n"
+    "peak_slip_rate (m/s), b_value, b_error, mc, b_events (as `bksim stats` gives them),\n"
+    "energy_residual, steps, rhs_evals, transitions, t_reached, wall_time, cpu_time (s),\n"
+    "seed, method, host, catalog; nan where a run has none.  The catalog figures (events\n"
+    "to b_events) count the rows of the run's /ruptures (else /events, as `bksim stats`),\n"
+    "and catalog names the table.  Written to DIR/summary.tsv (a '#' line of units, a\n"
+    "header line, tab-separated rows: scripts/plot_summary.sh draws any column against any\n"
+    "other) and DIR/summary.h5 (compound dataset /summary).  Runs that did not finish\n"
+    "(*.h5.part) are not summarised; other files left out are named on stderr.\n"
+    "  --table NAME                as for `bksim stats` (events: the time-window catalog);\n"
+    "                              a run without that table is left out\n"
+    "  --mc, --bin, --from, --to   as for `bksim stats`: the catalog figures use them\n";
+
+int bk_cli_export(int argc, char **argv)
+{
+    if (bk_cli_wants_help(argc, argv)) {
+        fputs(export_help, stdout);
+        return 0;
+    }
+    const char *path = NULL, *datasets = NULL, *table = NULL;
+    long block = -1;
+    int transitions = 0, events = 0;
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        if (strcmp(a, "--datasets") == 0 && i + 1 < argc) {
+            datasets = argv[++i];
+        } else if (strncmp(a, "--datasets=", 11) == 0) {
+            datasets = a + 11;
+        } else if ((strcmp(a, "--block") == 0 && i + 1 < argc) || strncmp(a, "--block=", 8) == 0) {
+            const char *text = a[7] == '=' ? a + 8 : argv[++i];
+            char *end = NULL;
+            errno = 0;
+            block = strtol(text, &end, 10);
+            if (errno || end == text || *end != '\0' || block < 0)
+                return bk_cli_usage_error("export", "--block needs a block index >= 0, got '%s'", text);
+        } else if (strcmp(a, "--transitions") == 0) {
+            transitions = 1;
+        } else if (strcmp(a, "--events") == 0) {
+            events = 1;
+        } else if (strcmp(a, "--table") == 0 && i + 1 < argc) {
+            table = argv[++i];
+        } else if (strncmp(a, "--table=", 8) == 0) {
+            table = a + 8;
+        } else if (a[0] == '-') {
+            return bk_cli_usage_error("export", "unknown or incomplete option '%s'", a);
+        } else if (!path) {
+            path = a;
+        } else {
+            return bk_cli_usage_error("export", "unexpected argument '%s'", a);
+        }
+    }
+    if (!path)
+        return bk_cli_usage_error("export", "%s", "missing OUT.h5");
+    if (events && (datasets || block >= 0 || transitions))
+        return bk_cli_usage_error("export", "%s", "--events prints the whole catalog: it takes none "
+                                           "of --datasets, --block, --transitions");
+    if (table && (datasets || block >= 0 || transitions || events))
+        return bk_cli_usage_error("export", "%s", "--table prints one whole table: it takes none of --datasets, "
+                                           "--block, --transitions, --events");
+    if (table && !*table)
+        return bk_cli_usage_error("export", "%s", "--table needs a table name (ruptures, rupture_blocks, rupture_rate, "
+                                           "events, transitions)");
+    bk_error err = {0};
+    int rc = table    ? bk_h5_export_table(path, table, stdout, &err)
+             : events ? bk_h5_export_events(path, stdout, &err)
+                      : bk_h5_export(path, datasets, block, transitions, stdout, &err);
+    if (rc != BK_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return EXIT_RUN_FAILED;
+    }
+    return 0;
+}
+
+/* The catalog options of stats and summary (--mc, --bin, --from, --to into opt, --table into
+ * *table) at argv[*i]: -1 when argv[*i] is none of them, 0 when taken (*i advanced past a
+ * separate value), else the exit status of a usage error.  Ranges (finite, a bin centre, ...)
+ * are bk_stats_options_check's. */
+static int parse_catalog_option(const char *command, int argc, char **argv, int *i,
+                                bk_stats_options *opt, const char **table)
+{
+    static const char *const names[] = {"--mc", "--bin", "--from", "--to", "--table"};
+    const char *a = argv[*i], *value = NULL;
+    size_t which = 0;
+    for (; which < 5; ++which) {
+        size_t len = strlen(names[which]);
+        if (strcmp(a, names[which]) == 0 && *i + 1 < argc) {
+            value = argv[++*i];
+            break;
+        }
+        if (strncmp(a, names[which], len) == 0 && a[len] == '=') {
+            value = a + len + 1;
+            break;
+        }
+    }
+    if (!value)
+        return -1;
+    char *end = NULL;
+    errno = 0;
+    if (which == 4) {
+        if (!*value || strcmp(value, "/") == 0)
+            return bk_cli_usage_error(command, "%s", "--table needs a table name: ruptures, events, or "
+                                              "another table with t_start and magnitude");
+        *table = value;
+    } else if (which == 0) {
+        opt->mc_auto = strcmp(value, "auto") == 0;
+        if (!opt->mc_auto) {
+            opt->mc = strtod(value, &end);
+            if (errno || end == value || *end)
+                return bk_cli_usage_error(command, "--mc needs 'auto' or a magnitude, got '%s'", value);
+        }
+    } else if (which == 1) {
+        opt->dm = strtod(value, &end);
+        if (errno || end == value || *end)
+            return bk_cli_usage_error(command, "--bin needs a bin width 0 < DM <= 10, got '%s'", value);
+    } else {
+        double t = strtod(value, &end);
+        if (errno || end == value || *end || !isfinite(t))
+            return bk_cli_usage_error(command, "%s needs a time in s, got '%s'", names[which], value);
+        *(which == 2 ? &opt->t_from : &opt->t_to) = t;
+    }
+    return 0;
+}
+
+int bk_cli_stats(int argc, char **argv)
+{
+    if (bk_cli_wants_help(argc, argv)) {
+        fputs(stats_help, stdout);
+        return 0;
+    }
+    bk_stats_options opt;
+    bk_stats_options_default(&opt);
+    const char *path = NULL, *tsv_dir = NULL, *table = NULL;
+    int json = 0;
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        int taken = parse_catalog_option("stats", argc, argv, &i, &opt, &table);
+        if (taken > 0)
+            return taken;
+        if (taken == 0)
+            continue;
+        if (strcmp(a, "--tsv") == 0 && i + 1 < argc) {
+            tsv_dir = argv[++i];
+        } else if (strncmp(a, "--tsv=", 6) == 0) {
+            tsv_dir = a + 6;
+        } else if (strcmp(a, "--json") == 0) {
+            json = 1;
+        } else if (a[0] == '-') {
+            return bk_cli_usage_error("stats", "unknown or incomplete option '%s'", a);
+        } else if (!path) {
+            path = a;
+        } else {
+            return bk_cli_usage_error("stats", "unexpected argument '%s'", a);
+        }
+    }
+    if (!path)
+        return bk_cli_usage_error("stats", "%s", "missing FILE");
+    bk_error err = {0};
+    if (bk_stats_options_check(&opt, &err) != BK_OK)
+        return bk_cli_usage_error("stats", "%s", err.message);
+    bk_stats_report *report = NULL;
+    int rc = bk_stats_report_read(path, table, &opt, &report, &err);
+    /* Tables first: a directory that cannot be written fails before anything is printed. */
+    if (rc == BK_OK && tsv_dir)
+        rc = bk_stats_report_tsv(report, tsv_dir, &err);
+    if (rc == BK_OK)
+        rc = json ? bk_stats_report_json(report, stdout, &err)
+                  : bk_stats_report_text(report, stdout, &err);
+    bk_stats_report_free(report);
+    if (rc != BK_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return EXIT_RUN_FAILED;
+    }
+    return 0;
+}
+
+int bk_cli_summary(int argc, char **argv)
+{
+    if (bk_cli_wants_help(argc, argv)) {
+        fputs(summary_help, stdout);
+        return 0;
+    }
+    bk_stats_options opt;
+    bk_stats_options_default(&opt);
+    const char *dir = NULL, *table = NULL;
+    for (int i = 0; i < argc; ++i) {
+        int taken = parse_catalog_option("summary", argc, argv, &i, &opt, &table);
+        if (taken > 0)
+            return taken;
+        if (taken == 0)
+            continue;
+        if (argv[i][0] == '-')
+            return bk_cli_usage_error("summary", "unknown or incomplete option '%s'", argv[i]);
+        if (dir)
+            return bk_cli_usage_error("summary", "unexpected argument '%s'", argv[i]);
+        dir = argv[i];
+    }
+    if (!dir)
+        return bk_cli_usage_error("summary", "%s", "missing DIR");
+    bk_error err = {0};
+    if (bk_stats_options_check(&opt, &err) != BK_OK)
+        return bk_cli_usage_error("summary", "%s", err.message);
+    size_t runs = 0;
+    if (bk_h5_summary(dir, table, &opt, stderr, &runs, &err) != BK_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return EXIT_RUN_FAILED;
+    }
+    printf("%s/summary.tsv, %s/summary.h5: %zu run%s\n", dir, dir, runs, runs == 1 ? "" : "s");
+    return 0;
+}
+
