@@ -4,6 +4,7 @@
  * [friction]) or from the key's default; what no single value can show is checked here:
  * missing keys, a law's parameters against each other, derived defaults and initial energies
  * that overflow, the method against the scene, and the output's size guards. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -55,6 +56,52 @@ static double block_value(loader *ld, size_t i, const key_def *def, int *given)
     double value = !e ? param->default_value : e->distribution ? bk_config_draw(ld, e, i, param) : e->number;
     bk_config_record_parameter(ld, "block", key, param->unit, i, value);
     return value;
+}
+
+/* A block without mass (quasi-dynamic): its slip rate is the root of its force balance
+ * A - eta v - F(v, theta) = 0 (island.c), which exists and is unique only for a law without a
+ * stuck state and a dashpot to the substrate.  Returns 0 after reporting what is missing. */
+static int check_quasi_dynamic(loader *ld, const bk_model *m, const bk_block *b, size_t i, int given_normal,
+                               int given_v)
+{
+    entry *e = bk_config_lookup_block(ld, "block", i, "mass");
+    if (!e)
+        e = bk_config_lookup(ld, "block", "mass");
+    if (!e)
+        return 1; /* mass missing altogether: reported as such */
+    if (b->law && b->law->static_threshold) {
+        bk_config_report_entry(ld, e, "0 (a quasi-dynamic block) needs a law without a stuck state "
+                               "(dieterich_ruina_aging, dieterich_ruina_slip); block %zu's law %s sticks, and a "
+                               "force balance without inertia does not say when it breaks away (allowed: mass > 0 "
+                               "kg)", i, b->law->name);
+        return 0;
+    }
+    if (!(b->damping > 0.0)) {
+        bk_config_report_entry(ld, e, "0 (a quasi-dynamic block) needs [block] damping > 0 N s/m on block %zu: "
+                               "the radiation damping (eta = G / 2 c_s) that bounds its slip rate where friction "
+                               "weakens (allowed: mass > 0 kg, or damping > 0)", i);
+        return 0;
+    }
+    if (m->coupling_damping > 0.0) {
+        bk_config_report_entry(ld, e, "0 (a quasi-dynamic block) cannot have [model] coupling_damping = %g N s/m: "
+                               "dashpots between blocks without mass would tie their slip rates into one linear "
+                               "system per evaluation, which bksim does not solve (allowed: coupling_damping = 0, "
+                               "or mass > 0 kg)", m->coupling_damping);
+        return 0;
+    }
+    if (!given_normal) {
+        bk_config_report_entry(ld, e, "0 (a quasi-dynamic block) needs [block] normal_force on block %zu: its "
+                               "default, mass * gravity, would be 0 N (allowed: normal_force > 0 N)", i);
+        return 0;
+    }
+    if (given_v && b->v_init != 0.0) {
+        bk_config_report_entry(ld, e, "0 (a quasi-dynamic block) takes no [block] v_init (block %zu has %g m/s): its "
+                               "slip rate at t = 0 is the one its force balance gives; set the driver's "
+                               "start_position or x_init for the stress you want (allowed: v_init left out)",
+                               i, b->v_init);
+        return 0;
+    }
+    return 1;
 }
 
 /* Friction of block i: its law and parameters, completed and validated. */
@@ -362,6 +409,7 @@ static void build_chain(loader *ld, bk_config *c)
                 b->driver_stiffness = value;
         }
         b->normal_force = block_value(ld, i, def[NORMAL_FORCE], &given);
+        int given_normal = given;
         if (!given)
             b->normal_force = b->mass * m->gravity;
         if (!isfinite(b->normal_force) && ld->error_rank == LONG_MAX) {
@@ -373,8 +421,11 @@ static void build_chain(loader *ld, bk_config *c)
         /* Drawn for every block, so a block's value does not depend on its neighbours' keys. */
         b->x_init += block_value(ld, i, def[X_INIT_RANDOM], &given) * (2.0 * gsl_rng_uniform(rng) - 1.0);
         b->v_init = block_value(ld, i, def[V_INIT], &given);
+        int given_v = given;
         b->damping = block_value(ld, i, def[DAMPING], &given);
         build_friction(ld, b, i, m->driver.velocity);
+        if (b->mass == 0.0 && ld->error_rank == LONG_MAX && !check_quasi_dynamic(ld, m, b, i, given_normal, given_v))
+            break; /* one such block is enough */
         if (ld->error_rank != LONG_MAX && ld->error_rank >= RANK_MISSING)
             break; /* one missing key is enough; don't repeat it for every block */
     }
@@ -483,6 +534,42 @@ static void build_prescribed(loader *ld, bk_config *c)
         bk_config_report_entry(ld, t_end, "must be <= the schedule's length (%.10g s), got %s", total, t_end->value);
 }
 
+/* arkode_imex treats the springs explicitly and friction and dashpots implicitly.  On a block
+ * with mass that friction and dashpots overdamp (damping ratio zeta > 1, counting the law's
+ * direct effect dF/dv at the driver's speed), the slip rate relaxes onto its force balance at
+ * a rate the explicit springs must follow: steps of about 30 sqrt(rtol m / k) for motion whose
+ * own time scale is far longer (QDYN's spring-block: 1e10 steps at m = 1e-3 kg).  Refused up
+ * front; a block that sticks is left alone (its stuck phases are exact, its slips short). */
+static void check_imex(loader *ld, entry *method, const bk_model *m, double rtol)
+{
+    double speed = fabs(m->driver.velocity);
+    for (size_t i = 0; i < m->n_blocks; ++i) {
+        const bk_block *b = &m->blocks[i];
+        if (!(b->mass > 0.0) || !b->law || b->law->static_threshold)
+            continue;
+        double stiffness = bk_model_block_stiffness(m, i);
+        double eta = b->damping + bk_model_coupling_count(m, i) * m->coupling_damping;
+        if (b->law->sliding_force_derivatives && speed > 0.0) {
+            double state[BK_FRICTION_MAX_STATE] = {0}, d_rate, d_state;
+            if (b->law->state_init)
+                b->law->state_init(b->friction_params, state);
+            b->law->sliding_force_derivatives(b->friction_params, b->normal_force, speed, state, &d_rate, &d_state);
+            eta += d_rate;
+        }
+        double zeta = stiffness > 0.0 ? eta / (2.0 * sqrt(stiffness * b->mass)) : INFINITY;
+        if (zeta > 1.0) {
+            double step = 30.0 * sqrt(rtol * b->mass / fmax(stiffness, DBL_MIN));
+            bk_config_report_entry(ld, method,
+                                   "integrates the springs explicitly, and block %zu is overdamped (damping ratio "
+                                   "%.3g with its dashpots and its friction's dF/dv at the driver's speed): its steps "
+                                   "stay near 30 sqrt(rtol m / k) = %.3g s however slowly it creeps (allowed: "
+                                   "arkode_dirk, cvode_bdf or gsl_msbdf; or [block] mass = 0, quasi-dynamic)",
+                                   i, zeta, step);
+            return;
+        }
+    }
+}
+
 /* The method fits the scene and takes the options given: method = exact solves only
  * affine scenes, arkode_table needs a method with tables.  Said here, before any output. */
 static void check_method_fits(loader *ld, const bk_config *c)
@@ -497,6 +584,9 @@ static void check_method_fits(loader *ld, const bk_config *c)
         else if (b->check_options(&c->solver, message, sizeof message) != 0)
             bk_config_report_entry(ld, table, "%s", message);
     }
+    if (method && strcmp(method->value, "arkode_imex") == 0 && c->model && !c->prescribed &&
+        ld->error_rank == LONG_MAX)
+        check_imex(ld, method, c->model, c->solver.rtol);
     if (!method || strcmp(method->value, "exact") != 0 || !c->model || c->prescribed ||
         ld->error_rank != LONG_MAX)
         return;

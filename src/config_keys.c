@@ -70,7 +70,9 @@ static const key_def keys[] = {
     INT("model", "seed", 1, 0, 4294967295.0, 0,
         "seed of the random numbers drawn at load time (x_init_random, distributions); same seed, same run"),
 
-    NUM("block", "mass", "kg", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED | BK_PARAM_MIN_EXCLUSIVE, "block mass"),
+    NUM("block", "mass", "kg", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED,
+        "block mass; 0: a quasi-dynamic block (no inertia: its force balance with [block] damping > 0 gives its "
+        "slip rate; laws that never stick only)"),
     NUM("block", "driver_stiffness", "N/m", NAN, 0.0, INFINITY, BK_PARAM_REQUIRED,
         "stiffness of the spring from the driver to the block"),
     {"block", {"normal_force", "N", NAN, 0.0, INFINITY, BK_PARAM_DERIVED | BK_PARAM_MIN_EXCLUSIVE,
@@ -115,7 +117,7 @@ static const key_def keys[] = {
      "rtol * 1e-3 * min(driver speed, max(F_s / k) * omega_max)"},
     {"solver", {"max_step", "s", NAN, 0.0, INFINITY, BK_PARAM_DERIVED | BK_PARAM_MIN_EXCLUSIVE,
                 "largest integrator step (keeps a slip-rate extremum from hiding inside a step)"},
-     BK_KEY_NUMBER, NULL, NULL, "1/8 of the fastest natural period"},
+     BK_KEY_NUMBER, NULL, NULL, "1/8 of the shortest time scale: the fastest damped oscillation, or a friction state's relaxation where no block oscillates"},
     INT("solver", "max_steps", 100000, 1, INT_MAX, 0, "integrator steps allowed between two output rows or transitions (a hang guard)"),
     {"solver", {"detect_velocity_extrema", "", 1, 0, 1, 0,
                 "locate slip-rate minima to catch a stop hidden inside one step"}, BK_KEY_BOOLEAN, NULL, NULL, "true"},
@@ -129,7 +131,7 @@ static const key_def keys[] = {
         "a step size below this stops the run with an error (0: no limit)"),
     {"solver", {"arkode_table", "", 0, 0, 0, 0,
                 "Butcher table of arkode_erk (an explicit ARKODE_* table) or arkode_dirk (a DIRK one); default: "
-                "the method's own (Zonneveld 5_3_4, SDIRK 5_3_4)"},
+                "the method's own (Zonneveld 5_3_4, ESDIRK43I6L2SA 6_3_4)"},
      BK_KEY_CHOICE, NULL, bk_solver_arkode_table, "default"},
 
     {"output", {"path", "", 0, 0, 0, 0, "HDF5 output file (bksim run -o overrides)"}, BK_KEY_TEXT, NULL, NULL,

@@ -96,13 +96,15 @@ size_t bk_config_warnings(const bk_config *config, bk_warning_fn warn, void *use
             "holds every one)",
             name, interval, slip);
 
-    double omega = bk_model_max_angular_frequency(m);
-    double period = omega > 0.0 ? 2.0 * BK_PI / omega : INFINITY;
+    /* Only an oscillation hides an extremum or a slip inside a step: a block that cannot
+     * oscillate (overdamped, or without mass) moves on its friction's time scale, which the
+     * error control resolves, so a long max_step there is no mistake. */
+    double period = bk_model_damped_period(m);
     if (isfinite(config->solver.max_step) && config->solver.max_step > period)
         say(warn, user, &count,
-            "%s: [solver] max_step = %g s is longer than the fastest natural period (%.3g s): "
-            "a slip-rate extremum, or a whole slip, can hide inside one step (default: 1/8 of "
-            "that period)",
+            "%s: [solver] max_step = %g s is longer than the fastest damped oscillation's period "
+            "(%.3g s): a slip-rate extremum, or a whole slip, can hide inside one step (default: "
+            "1/8 of it)",
             name, config->solver.max_step, period);
     return count;
 }

@@ -12,6 +12,7 @@
  *             g = s a                          rises through 0 at a slip-rate minimum, where
  *                                              a stop hidden inside one step shows as s v < 0
  *   tension-only spring: g = D - x             the spring's kink (slack/taut) */
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -167,6 +168,121 @@ static size_t half_bandwidth(const bk_island *island, size_t local)
     return width;
 }
 
+/* d(sliding force)/d(slip rate) and d/d(state) of block i (N s/m, N per state unit). */
+static void friction_derivatives(const bk_scene *scene, size_t i, double slip_rate, const double *state,
+                                 double *d_rate, double *d_state)
+{
+    const bk_block *b = &scene->model->blocks[i];
+    const bk_friction_law *law = b->law;
+    if (law->sliding_force_derivatives) {
+        law->sliding_force_derivatives(b->friction_params, scene->normal[i], slip_rate, state, d_rate, d_state);
+        return;
+    }
+    double h = 1e-6 * fmax(fabs(slip_rate), 1e-9);
+    *d_rate = (law->sliding_force(b->friction_params, scene->normal[i], slip_rate + h, state) -
+               law->sliding_force(b->friction_params, scene->normal[i], slip_rate - h, state)) /
+              (2.0 * h);
+    if (law->n_state == 0) {
+        *d_state = 0.0;
+        return;
+    }
+    double shifted[BK_FRICTION_MAX_STATE];
+    double hs = 1e-6 * fmax(fabs(state[0]), 1e-12);
+    shifted[0] = state[0] + hs;
+    double up = law->sliding_force(b->friction_params, scene->normal[i], slip_rate, shifted);
+    shifted[0] = state[0] - hs;
+    double down = law->sliding_force(b->friction_params, scene->normal[i], slip_rate, shifted);
+    *d_state = (up - down) / (2.0 * hs);
+}
+
+/* --- blocks without mass (quasi-dynamic) ------------------------------------------------
+ * Such a block's slip rate is fixed by its force balance
+ *     Phi(v) = A - eta v - F(v, theta) = 0,   A = driver spring + coupling springs,
+ * (no dashpots between blocks: config_build.c refuses them), which falls strictly in v for a
+ * law that never sticks (F odd and increasing in v, eta > 0).  The ODE back-ends integrate v
+ * as QDYN does, by the balance's time derivative
+ *     v' = (A' - dF/dtheta theta') / (eta + dF/dv),   A' = k (V_driver - v) + sum kc (v_j - v),
+ * plus a pull back onto the balance (balance_acceleration), and every restart puts v on
+ * the balance itself (balance_velocity), to rounding.  IDA keeps the balance
+ * as the algebraic row it is (Phi in the velocity row, differential_id 0). */
+
+/* The springs' force on block i, and its rate of change (N, N/s). */
+static void spring_load(const bk_island *island, double t, const double *y, size_t i, double *force,
+                        double *rate)
+{
+    const bk_scene *scene = island->scene;
+    const bk_model *model = scene->model;
+    double driver_pos = bk_driver_segment_position(&model->driver, island->driver_segment, t);
+    double driver_speed = bk_driver_segment_velocity(&model->driver, island->driver_segment);
+    double x_i = position(island, y, (long)i), v_i = velocity(island, y, (long)i);
+    *force = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i);
+    int taut = model->spring == BK_SPRING_LINEAR || scene->taut[i];
+    double r = taut ? model->blocks[i].driver_stiffness * (driver_speed - v_i) : 0.0;
+    double kc = model->coupling_stiffness;
+    if (kc != 0.0) {
+        const long *partner = bk_scene_partners(scene, i);
+        for (size_t d = 0; d < scene->n_directions; ++d)
+            if (partner[d] != -1)
+                r += kc * (velocity(island, y, partner[d]) - v_i);
+    }
+    *rate = r;
+}
+
+/* The slip rate of block i (without mass) on its force balance, bracketed Newton to
+ * rounding: Phi(0) = A and Phi(A / eta) = -F(A / eta) bracket the root. */
+static double balance_velocity(const bk_island *island, double t, const double *y, size_t i, double guess)
+{
+    const bk_scene *scene = island->scene;
+    const bk_block *b = &scene->model->blocks[i];
+    const double *state = block_state(island, y, i);
+    double load, rate;
+    spring_load(island, t, y, i, &load, &rate);
+    double eta = b->damping;
+    double lo = fmin(0.0, load / eta), hi = fmax(0.0, load / eta);
+    double v = guess > lo && guess < hi ? guess : 0.5 * (lo + hi);
+    for (int iter = 0; iter < 200 && hi > lo; ++iter) {
+        double d_rate, d_state;
+        double phi = load - eta * v - b->law->sliding_force(b->friction_params, scene->normal[i], v, state);
+        if (phi == 0.0)
+            return v;
+        if (phi > 0.0)
+            lo = v;
+        else
+            hi = v;
+        friction_derivatives(scene, i, v, state, &d_rate, &d_state);
+        double next = v + phi / (eta + d_rate);
+        if (!(next > lo && next < hi))
+            next = 0.5 * (lo + hi);
+        if (fabs(next - v) <= 2.0 * DBL_EPSILON * fabs(v) || next == lo || next == hi)
+            return next;
+        v = next;
+    }
+    return v;
+}
+
+/* v' of block i (without mass) from the balance's time derivative. */
+static double balance_acceleration(const bk_island *island, double t, const double *y, size_t i)
+{
+    const bk_scene *scene = island->scene;
+    const bk_block *b = &scene->model->blocks[i];
+    const double *state = block_state(island, y, i);
+    double load, rate, d_rate, d_state;
+    spring_load(island, t, y, i, &load, &rate);
+    double v_i = y[scene->slot[i] + 1];
+    friction_derivatives(scene, i, v_i, state, &d_rate, &d_state);
+    double state_change = 0.0;
+    if (state) {
+        double st_rate[BK_FRICTION_MAX_STATE];
+        b->law->state_rate(b->friction_params, fabs(v_i), state, st_rate);
+        state_change = d_state * st_rate[0];
+    }
+    /* d Phi / dt = -Phi / balance_time: zero on the balance, so the exact solution is the
+     * balance's, while the integrator's drift off it (which the derivative alone keeps and
+     * accumulates between restarts) decays instead. */
+    double residual = load - b->damping * v_i - b->law->sliding_force(b->friction_params, scene->normal[i], v_i, state);
+    return (rate - state_change + residual / scene->balance_time) / (b->damping + d_rate);
+}
+
 void bk_island_restart(bk_island *island, double t, double *y)
 {
     bk_scene *scene = island->scene;
@@ -175,6 +291,7 @@ void bk_island_restart(bk_island *island, double t, double *y)
     size_t max_state = 0;
     island->n_active = 0;
     island->n_stateful = 0;
+    island->n_massless = 0;
     island->affine = scene->affine && !scene->full_layout;
     island->driver_segment = bk_driver_segment(&model->driver, t);
     double driver_pos = bk_driver_segment_position(&model->driver, island->driver_segment, t);
@@ -196,7 +313,11 @@ void bk_island_restart(bk_island *island, double t, double *y)
             island->active[island->n_active++] = i;
             y[next] = 0.0;
             y[next + 1] = scene->v[i];
-            island->differential_id[next] = island->differential_id[next + 1] = 1.0;
+            island->differential_id[next] = 1.0;
+            /* Without mass, IDA keeps the force balance as an algebraic row. */
+            island->differential_id[next + 1] = b->mass > 0.0 || !scene->full_layout ? 1.0 : 0.0;
+            if (!(b->mass > 0.0))
+                island->n_massless++;
             next += 2;
         } else {
             scene->v[i] = 0.0;
@@ -223,10 +344,9 @@ void bk_island_restart(bk_island *island, double t, double *y)
             if (ns > max_state)
                 max_state = ns;
         }
-        island->root_direction[R * k + BK_ROOT_MAIN] = scene->can_stick[i]        ? -1
-                                                        : !scene->above     ? 0
-                                                        : scene->above[i]   ? -1
-                                                                            : +1;
+        /* A threshold crossing is located either way: the integration runs on through it
+         * (run_events.c), so the direction to look for next is not known at a restart. */
+        island->root_direction[R * k + BK_ROOT_MAIN] = scene->can_stick[i] ? -1 : 0;
         island->root_direction[R * k + BK_ROOT_EXTREMUM] = dir != 0 && scene->can_stick[i] ? +1 : 0;
         if (R > 2)
             island->root_direction[R * k + BK_ROOT_SLACK] = 0;
@@ -239,6 +359,17 @@ void bk_island_restart(bk_island *island, double t, double *y)
     island->n_y = next + scene->n_energy;
     island->half_bandwidth = half_bandwidth(island, 3 + max_state);
     island->t_ref = t;
+    /* Blocks without mass start on their force balance (the whole layout is in place now:
+     * the balance reads the neighbours' positions). */
+    for (size_t k = 0; k < island->n_active && island->n_massless > 0; ++k) {
+        size_t i = island->active[k], s = scene->slot[i];
+        if (model->blocks[i].mass > 0.0)
+            continue;
+        y[s + 1] = balance_velocity(island, t, y, i, y[s + 1]);
+        scene->v[i] = y[s + 1];
+        if (y[s + 1] != 0.0)
+            scene->mode[i] = (int8_t)(y[s + 1] > 0.0 ? BK_MODE_SLIP_POS : BK_MODE_SLIP_NEG);
+    }
     for (size_t k = 0; k < island->n_active; ++k) {
         size_t i = island->active[k];
         if (scene->from_rest[i] && scene->t_switch[i] == t)
@@ -326,7 +457,17 @@ static void rhs_parts(const bk_island *island, double t, const double *y, double
         double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
                                                 block_state(island, y, i));
         ydot[s] = v_i;
-        if (f_implicit) {
+        if (!(b->mass > 0.0)) {
+            /* IDA: the balance itself; the ODE back-ends: its time derivative, stiff. */
+            double row = scene->full_layout ? applied + dashpots - dir * friction
+                                            : balance_acceleration(island, t, y, i);
+            if (f_implicit) {
+                ydot[s + 1] = 0.0;
+                f_implicit[s + 1] = row;
+            } else {
+                ydot[s + 1] = row;
+            }
+        } else if (f_implicit) {
             ydot[s + 1] = applied / b->mass;
             f_implicit[s + 1] = (dashpots - dir * friction) / b->mass;
         } else {
@@ -378,29 +519,6 @@ int bk_island_rhs_split(double t, const double *y, double *f_explicit, double *f
     return 0;
 }
 
-/* d(sliding force)/d(slip rate) and d/d(state) of block i (N s/m, N per state unit). */
-static void friction_derivatives(const bk_scene *scene, size_t i, double slip_rate, const double *state,
-                                 double *d_rate, double *d_state)
-{
-    const bk_block *b = &scene->model->blocks[i];
-    const bk_friction_law *law = b->law;
-    double h = 1e-6 * fmax(fabs(slip_rate), 1e-9);
-    *d_rate = (law->sliding_force(b->friction_params, scene->normal[i], slip_rate + h, state) -
-               law->sliding_force(b->friction_params, scene->normal[i], slip_rate - h, state)) /
-              (2.0 * h);
-    if (law->n_state == 0) {
-        *d_state = 0.0;
-        return;
-    }
-    double shifted[BK_FRICTION_MAX_STATE];
-    double hs = 1e-6 * fmax(fabs(state[0]), 1e-12);
-    shifted[0] = state[0] + hs;
-    double up = law->sliding_force(b->friction_params, scene->normal[i], slip_rate, shifted);
-    shifted[0] = state[0] - hs;
-    double down = law->sliding_force(b->friction_params, scene->normal[i], slip_rate, shifted);
-    *d_state = (up - down) / (2.0 * hs);
-}
-
 /* `value` at (row, slot + offset) of each partner of block i this island integrates: the
  * coupling's entries, to a partner's position (offset 0) or velocity (1). */
 static void put_partners(const bk_island *island, size_t i, size_t row, size_t offset, double value,
@@ -420,7 +538,7 @@ static void damping_jacobian(const bk_island *island, const double *y, size_t i,
 {
     const bk_scene *scene = island->scene;
     const bk_model *model = scene->model;
-    double etac = model->coupling_damping, m = model->blocks[i].mass;
+    double etac = model->coupling_damping, m = model->blocks[i].mass > 0.0 ? model->blocks[i].mass : 1.0;
     if (!bk_scene_stuck(scene, i)) {
         put(matrix, s + 1, s + 1, -(model->blocks[i].damping + etac * bk_scene_coupling_count(scene, i)) / m);
         if (etac > 0.0)
@@ -443,7 +561,9 @@ static void jacobian_parts(const bk_island *island, const double *y, int frictio
     for (size_t k = 0; k < island->n_active; ++k) {
         size_t i = island->active[k], s = scene->slot[i];
         const bk_block *b = &model->blocks[i];
-        double dir = (double)scene->mode[i], v_i = y[s + 1], m = b->mass;
+        /* A block without mass has its balance as the row (IDA only: the ODE layout of such
+         * an island takes difference quotients, see run_islands.c), i.e. m = 1. */
+        double dir = (double)scene->mode[i], v_i = y[s + 1], m = b->mass > 0.0 ? b->mass : 1.0;
         double spring = model->spring == BK_SPRING_TENSION_ONLY && !scene->taut[i] ? 0.0 : b->driver_stiffness;
         if (!friction_only) {
             put(matrix, s, s + 1, 1.0); /* xi' = v */
@@ -570,6 +690,8 @@ double bk_island_slip_acceleration(const bk_island *island, size_t i, double t, 
     double driver_pos = bk_driver_segment_position(&scene->model->driver, island->driver_segment, t);
     double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
     double dir = (double)scene->mode[i];
+    if (!(b->mass > 0.0))
+        return dir * balance_acceleration(island, t, y, i);
     double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) +
                      damping_force(island, y, i);
     double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,

@@ -185,12 +185,48 @@ double bk_model_max_angular_frequency(const bk_model *model)
     double max_rate = 0.0;
     for (size_t i = 0; i < model->n_blocks; ++i) {
         const bk_block *b = &model->blocks[i];
+        if (!(b->mass > 0.0))
+            continue; /* without mass, no oscillator */
         double row = b->driver_stiffness + 2.0 * bk_model_coupling_count(model, i) * model->coupling_stiffness;
         double rate = row / b->mass;
         if (rate > max_rate)
             max_rate = rate;
     }
     return sqrt(max_rate);
+}
+
+/* A step limit exists so that a root cannot hide inside one step: a stop, or a slip-rate
+ * extremum, inside an oscillation.  A block that cannot oscillate hides none, and the only
+ * scale left to it is its friction's: a state relaxing over Dc / v. */
+double bk_model_damped_period(const bk_model *model)
+{
+    double max_rate = 0.0;
+    for (size_t i = 0; i < model->n_blocks; ++i) {
+        const bk_block *b = &model->blocks[i];
+        if (!(b->mass > 0.0))
+            continue;
+        double row = b->driver_stiffness + 2.0 * bk_model_coupling_count(model, i) * model->coupling_stiffness;
+        double decay = b->damping / (2.0 * b->mass);
+        double rate = row / b->mass - decay * decay;
+        if (rate > max_rate)
+            max_rate = rate;
+    }
+    return max_rate > 0.0 ? 2.0 * 3.14159265358979323846 / sqrt(max_rate) : INFINITY;
+}
+
+double bk_model_step_time_scale(const bk_model *model)
+{
+    double period = bk_model_damped_period(model);
+    if (isfinite(period))
+        return period;
+    double speed = fabs(model->driver.velocity);
+    double shortest = INFINITY;
+    for (size_t i = 0; i < model->n_blocks && speed > 0.0; ++i) {
+        const bk_block *b = &model->blocks[i];
+        if (b->law && b->law->relaxation_time)
+            shortest = fmin(shortest, b->law->relaxation_time(b->friction_params, speed));
+    }
+    return shortest;
 }
 
 size_t bk_model_first_non_affine_block(const bk_model *model)

@@ -173,7 +173,6 @@ static void resolve_scales(run_ctx *ctx)
     const bk_model *model = ctx->model;
     bk_solver_options *opt = &ctx->options;
     double omega = bk_model_max_angular_frequency(model);
-    double period = omega > 0.0 ? 2.0 * PI / omega : INFINITY;
     double length = 0.0, force = 0.0;
     for (size_t i = 0; i < model->n_blocks; ++i) {
         double stiffness = bk_model_block_stiffness(model, i);
@@ -202,10 +201,13 @@ static void resolve_scales(run_ctx *ctx)
         state_scale = fmax(state_scale, fabs(ctx->scene.state[k]));
     ctx->atol_state = opt->rtol * 1e-3 * (state_scale > 0.0 ? state_scale : 1.0);
     ctx->atol_energy = ctx->atol_x * force;
+    double scale = bk_model_step_time_scale(model);
+    /* Short beside everything the scene resolves, long beside what explicit methods step. */
+    ctx->scene.balance_time = isfinite(scale) ? scale / 8.0 : 1e-3 * ctx->t_end;
     if (isnan(opt->max_step))
-        opt->max_step = isfinite(period) ? period / 8.0 : 0.0;
+        opt->max_step = isfinite(scale) ? scale / 8.0 : 0.0;
     ctx->instant_window = !isnan(opt->instant_window) ? opt->instant_window
-                          : isfinite(period)           ? 1e-6 * period
+                          : isfinite(scale)            ? 1e-6 * scale
                                                        : 1e-12 * ctx->t_end;
 }
 

@@ -32,6 +32,8 @@ typedef struct run_island {
     int live;
     int stepped;             /* stepped since its (re)start: else y holds the state at t_reached */
     double t_reached;        /* s, where the integrator is */
+    double t_resume;         /* s, its (re)start, or the crossing it carried on through:
+                                the steps before it are handled */
     /* The event the last step found, handled when its time comes. */
     int pending;
     int from_root;           /* a root fired (else a stop was missed at a step end) */
@@ -239,7 +241,7 @@ int bk_run_record_transition(run_ctx *ctx, double t, size_t i, bk_mode from, bk_
                              double applied_force);
 /* Block i (a law without a stuck state, unpacked at t) crosses the slip-rate threshold: a
  * transition for the catalog only. */
-int bk_run_record_crossing(run_ctx *ctx, double t, size_t i);
+int bk_run_record_crossing(run_ctx *ctx, double t, size_t i, int rising);
 /* Send the buffered transitions of the instant, in block order. */
 int bk_run_flush_instant(run_ctx *ctx);
 
@@ -272,6 +274,9 @@ int bk_run_ruptures_finish(run_ctx *ctx, double t);
 int bk_run_ruptures_save(run_ctx *ctx, bk_catalog_state *state);
 /* Speed samples of an island just (re)started, and of its last step. */
 int bk_run_ruptures_island_start(run_ctx *ctx, const run_island *isl);
+/* Block i crossed the slip-rate threshold at t and its island carries on through: the
+ * sample island_start would have taken. */
+int bk_run_ruptures_crossed(run_ctx *ctx, size_t i, double t);
 int bk_run_ruptures_island_step(run_ctx *ctx, run_island *isl);
 
 /* ---- run_books.c ---- */

@@ -44,8 +44,8 @@ static int locate_hidden_stop(run_ctx *ctx, run_island *isl, size_t i, double t_
 {
     double lo, hi;
     ctx->backend->last_step(isl->solver, &lo, &hi);
-    if (lo < isl->island.t_ref)
-        lo = isl->island.t_ref;
+    if (lo < isl->t_resume)
+        lo = isl->t_resume;
     bk_block_probe probe = {ctx, isl, i, BK_OK};
     gsl_function fn = {stop_function, &probe};
     double f_lo = stop_function(lo, &probe), f_hi = stop_function(t_root, &probe);
@@ -189,18 +189,45 @@ int bk_run_apply_event(run_ctx *ctx, double t, size_t i, bk_mode_event event)
     return rc < 0 ? rc : 1;
 }
 
+/* Whether the pending event is only slip-rate threshold crossings of blocks that cannot
+ * stick.  Such a crossing changes the catalog, not the ODE: the integration goes on through
+ * it instead of restarting.  A restart would begin from the dense output at the crossing,
+ * whose error (at loose tolerances, more than the slip rate's distance from the threshold a
+ * moment later) a block with little mass sheds within m / damping, crossing back and forth:
+ * spurious events of nanoseconds.  Carrying on, each crossing is found once. */
+static int crossings_only(const run_ctx *ctx, const run_island *isl)
+{
+    const bk_scene *scene = &ctx->scene;
+    size_t R = scene->roots_per_block;
+    if (!isl->from_root || isl->hidden_block != SIZE_MAX)
+        return 0;
+    int any = 0;
+    for (size_t k = 0; k < isl->island.len; ++k)
+        for (size_t r = 0; r < R; ++r) {
+            if (isl->found[R * k + r] == 0)
+                continue;
+            if (r != BK_ROOT_MAIN || scene->can_stick[bk_island_block(&isl->island, k)])
+                return 0;
+            any = 1;
+        }
+    return any;
+}
+
 int bk_run_island_event(run_ctx *ctx, size_t id)
 {
     run_island *isl = ctx->islands[id];
     const bk_scene *scene = &ctx->scene;
     size_t R = scene->roots_per_block;
     double t = isl->t_event;
+    const bk_island *island = &isl->island;
+    int through = crossings_only(ctx, isl);
     bk_energy increments;
     int rc = bk_run_unpack_island(ctx, isl, t, 0, &increments);
     if (rc != BK_OK)
         return rc;
-    bk_energy_add(&ctx->closed, &increments);
-    const bk_island *island = &isl->island;
+    /* The energy quadratures run on when the integration does. */
+    if (!through)
+        bk_energy_add(&ctx->closed, &increments);
     /* Every root restarts the island.  A minimum that hid no stop disarms its root until the
      * block decelerates again, so the restart does not begin on a zero of it. */
     if (isl->hidden_block == SIZE_MAX)
@@ -218,7 +245,8 @@ int bk_run_island_event(run_ctx *ctx, size_t id)
         if (!fired)
             continue;
         if (!scene->can_stick[i]) {
-            if ((rc = bk_run_record_crossing(ctx, t, i)) != BK_OK)
+            if ((rc = bk_run_record_crossing(ctx, t, i, isl->found[R * k + BK_ROOT_MAIN] > 0)) != BK_OK ||
+                (through && (rc = bk_run_ruptures_crossed(ctx, i, t)) != BK_OK))
                 return rc;
             continue;
         }
@@ -229,6 +257,12 @@ int bk_run_island_event(run_ctx *ctx, size_t id)
         changed |= rc;
     }
     isl->pending = 0;
+    if (through) {
+        /* Nothing the integrator sees has changed: it carries on from where it is, past t. */
+        isl->t_resume = t;
+        bk_heap_set(&ctx->island_queue, id, isl->t_reached);
+        return BK_OK;
+    }
     if (changed && ctx->event_rows)
         ctx->t_row_due = t;
     if (!changed)

@@ -242,12 +242,15 @@ int bk_run_start_island(run_ctx *ctx, size_t id, double t)
         bk_heap_remove(&ctx->quiet, bk_island_block(island, k));
     bk_island_restart(island, t, isl->y);
     bk_island_tolerances(island, ctx->atol_x, ctx->atol_v, ctx->atol_state, ctx->atol_energy, isl->atol);
+    /* The velocity rows of blocks without mass are the force balance's time derivative in
+     * the ODE layout, whose Jacobian island.c does not write: difference quotients there. */
+    int exact_jacobian = island->n_massless == 0 || ctx->scene.full_layout;
     isl->problem = (bk_ode_problem){
         .user = island,
         .rhs = bk_island_rhs,
-        .jacobian = bk_island_jacobian,
+        .jacobian = exact_jacobian ? bk_island_jacobian : NULL,
         .rhs_split = bk_island_rhs_split,
-        .jacobian_implicit = bk_island_jacobian_implicit,
+        .jacobian_implicit = exact_jacobian ? bk_island_jacobian_implicit : NULL,
         .roots = bk_island_roots,
         .n_roots = bk_island_n_roots(island),
         .root_direction = island->root_direction,
@@ -269,6 +272,7 @@ int bk_run_start_island(run_ctx *ctx, size_t id, double t)
     isl->stepped = 0;
     isl->pending = 0;
     isl->t_reached = t;
+    isl->t_resume = t;
     bk_run_catalog_island_start(ctx, isl);
     if ((rc = bk_run_ruptures_island_start(ctx, isl)) != BK_OK)
         return rc;

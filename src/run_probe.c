@@ -84,7 +84,7 @@ int bk_run_last_step(run_ctx *ctx, run_island *isl, double *lo, double *hi, cons
             return rc;
         *y = isl->y_probe;
     }
-    if (*lo < isl->island.t_ref)
-        *lo = isl->island.t_ref;
+    if (*lo < isl->t_resume)
+        *lo = isl->t_resume;
     return BK_OK;
 }

@@ -159,6 +159,14 @@ int bk_run_ruptures_island_start(run_ctx *ctx, const run_island *isl)
     return BK_OK;
 }
 
+int bk_run_ruptures_crossed(run_ctx *ctx, size_t i, double t)
+{
+    /* Its speed and d|v|/dt at t are the last step's end values, kept while it crept. */
+    if (ctx->ruptures && bk_ruptures_sample(ctx->ruptures, i, t, fabs(ctx->scene.v[i])) != BK_OK)
+        return BK_FAIL(ctx->err, BK_ERR_NOMEM, "out of memory for the rupture catalog at t = %.17g s", t);
+    return BK_OK;
+}
+
 /* A slipping block's step: its speed and d|v|/dt at the step's end, and its interior peak. */
 typedef struct block_step {
     size_t block;
@@ -184,7 +192,7 @@ static size_t pieces(const run_ctx *ctx, const block_step *steps, size_t n, doub
     if (!(error > 0.0) || !(reference > 0.0))
         return 1;
     double k = ceil(sqrt(error / (RATE_TOL * reference)));
-    return k < 1.0 ? 1 : k > MAX_PIECES ? MAX_PIECES : (size_t)k;
+    return !(k >= 1.0) ? 1 : k > MAX_PIECES ? MAX_PIECES : (size_t)k; /* NaN: 1 */
 }
 
 int bk_run_ruptures_island_step(run_ctx *ctx, run_island *isl)

@@ -106,9 +106,11 @@ static int8_t catalog_mode(const run_ctx *ctx, size_t i)
     return scene->above[i] ? (int8_t)BK_MODE_SLIP_POS : (int8_t)BK_MODE_STICK;
 }
 
-int bk_run_record_crossing(run_ctx *ctx, double t, size_t i)
+int bk_run_record_crossing(run_ctx *ctx, double t, size_t i, int rising)
 {
     bk_scene *scene = &ctx->scene;
+    if (scene->above[i] == (uint8_t)(rising != 0))
+        return BK_OK; /* already on that side: the crossing was recorded */
     if (ctx->n_instant > 0 && t != ctx->t_instant) {
         int rc = bk_run_flush_instant(ctx);
         if (rc != BK_OK)
@@ -116,7 +118,7 @@ int bk_run_record_crossing(run_ctx *ctx, double t, size_t i)
     }
     double driver_pos = bk_driver_position(&ctx->model->driver, t);
     int8_t from = catalog_mode(ctx, i);
-    scene->above[i] = (uint8_t)!scene->above[i];
+    scene->above[i] = (uint8_t)(rising != 0);
     ctx->steps_since_row = 0; /* progress, as a transition is, for the hang guard */
     bk_transition crossing = {
         .t = t,

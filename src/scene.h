@@ -66,6 +66,8 @@ typedef struct bk_scene {
     int affine;              /* every law Coulomb-like, no dashpots: islands' ODEs are affine in y
                                 and t, accelerations independent of velocities */
     int damped;              /* some dashpot (bk_model_is_damped) */
+    double balance_time;     /* s: blocks without mass return to their force balance at this
+                                time constant when the integration drifts off it (island.c) */
     size_t n_energy;         /* energy increments at the end of an island's y: driver work, friction
                                 dissipation and, when damped, dashpot dissipation */
     size_t *slot;            /* per block: index of xi in its island's y, or BK_NO_SLOT */
@@ -158,6 +160,7 @@ typedef struct bk_island {
     double *differential_id; /* n_y: 1 for a differential component, 0 for an algebraic one */
     int *root_direction;     /* roots_per_block * len */
     int affine;              /* the compact ODE is affine in y and t (see bk_ode_problem) */
+    size_t n_massless;       /* active blocks without mass (quasi-dynamic; island.c) */
     size_t capacity;         /* blocks the arrays above have room for */
 } bk_island;
 

@@ -329,7 +329,7 @@ static void test_warnings_and_strict(void **state)
     } cases[] = {
         {"driver.velocity=1", "[driver] velocity = 1 m/s is faster than the blocks' own slip speeds"},
         {"output.interval=0.05", "[output] interval = 0.05 s is longer than a slip"},
-        {"solver.max_step=0.1", "[solver] max_step = 0.1 s is longer than the fastest natural period"},
+        {"solver.max_step=0.1", "[solver] max_step = 0.1 s is longer than the fastest damped oscillation's period"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         snprintf(cmd, sizeof cmd, "./bksim check configs/paper/case_a_coulomb.ini --set %s", cases[k].set);

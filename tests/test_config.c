@@ -414,6 +414,84 @@ typedef struct rejection {
     const char *line, *replacement, *message;
 } rejection;
 
+/* QDYN's spring-block without inertia, and what a block without mass needs. */
+static const char quasi_dynamic_config[] = "[model]\n"
+                                           "n_blocks = 3\n"
+                                           "coupling_stiffness = 1e9\n"
+                                           "[block]\n"
+                                           "mass = 0\n"
+                                           "driver_stiffness = 2e9\n"
+                                           "normal_force = 5e6\n"
+                                           "damping = 3.3e5\n"
+                                           "[friction]\n"
+                                           "law = dieterich_ruina_aging\n"
+                                           "a = 0.01\n"
+                                           "b = 0.015\n"
+                                           "Dc = 1e-5\n"
+                                           "V0 = 1e-5\n"
+                                           "f0 = 0.6\n"
+                                           "[driver]\n"
+                                           "velocity = 1e-5\n"
+                                           "[catalog]\n"
+                                           "slip_rate_threshold = 1e-2\n"
+                                           "[run]\n"
+                                           "t_end = 1\n";
+
+static void test_quasi_dynamic(void **state)
+{
+    (void)state;
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string(quasi_dynamic_config, "q.ini", NULL, 0, &c, &err), BK_OK);
+    assert_true(c->model->blocks[1].mass == 0.0);
+    bk_config_free(c);
+    /* Mixed: one block with mass among blocks without. */
+    const char *mixed[] = {"block.1.mass=1e-3"};
+    assert_int_equal(bk_config_load_string(quasi_dynamic_config, "q.ini", mixed, 1, &c, &err), BK_OK);
+    bk_config_free(c);
+    static const struct {
+        const char *set;
+        const char *message;
+    } cases[] = {
+        {"block.damping=0", "q.ini:5: [block] mass: 0 (a quasi-dynamic block) needs [block] damping > 0 N s/m on block 0"},
+        {"block.2.damping=0", "needs [block] damping > 0 N s/m on block 2"},
+        {"model.coupling_damping=1", "cannot have [model] coupling_damping = 1 N s/m"},
+        {"block.v_init=1e-5", "takes no [block] v_init (block 0 has 1e-05 m/s)"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        const char *set[] = {cases[k].set};
+        c = (bk_config *)&c;
+        int rc = bk_config_load_string(quasi_dynamic_config, "q.ini", set, 1, &c, &err);
+        if (rc != BK_ERR_CONFIG || !strstr(err.message, cases[k].message))
+            print_error("case %zu: rc %d\n got:      %s\n expected: %s\n", k, rc, err.message, cases[k].message);
+        assert_int_equal(rc, BK_ERR_CONFIG);
+        assert_null(c);
+        assert_non_null(strstr(err.message, cases[k].message));
+    }
+    /* A law that sticks. */
+    char text[2048];
+    snprintf(text, sizeof text, "%s", quasi_dynamic_config);
+    const char *rs = "law = dieterich_ruina_aging\na = 0.01\nb = 0.015\nDc = 1e-5\nV0 = 1e-5\nf0 = 0.6\n";
+    const char *coulomb = "law = coulomb\nmu_s = 0.6\nmu_d = 0.5\n";
+    char *law = strstr(text, rs);
+    assert_non_null(law);
+    memmove(law + strlen(coulomb), law + strlen(rs), strlen(law + strlen(rs)) + 1);
+    memcpy(law, coulomb, strlen(coulomb));
+    c = (bk_config *)&c;
+    assert_int_equal(bk_config_load_string(text, "q.ini", NULL, 0, &c, &err), BK_ERR_CONFIG);
+    assert_null(c);
+    assert_non_null(strstr(err.message, "q.ini:5: [block] mass: 0 (a quasi-dynamic block) needs a law without a stuck "
+                                        "state (dieterich_ruina_aging, dieterich_ruina_slip); block 0's law coulomb sticks"));
+    /* The default normal force, mass * gravity, would be 0. */
+    snprintf(text, sizeof text, "%s", quasi_dynamic_config);
+    char *line = strstr(text, "normal_force = 5e6\n");
+    memmove(line, line + strlen("normal_force = 5e6\n"), strlen(line + strlen("normal_force = 5e6\n")) + 1);
+    c = (bk_config *)&c;
+    assert_int_equal(bk_config_load_string(text, "q.ini", NULL, 0, &c, &err), BK_ERR_CONFIG);
+    assert_null(c);
+    assert_non_null(strstr(err.message, "needs [block] normal_force on block 0: its default, mass * gravity, would be 0 N"));
+}
+
 static void test_rejections(void **state)
 {
     (void)state;
@@ -430,23 +508,23 @@ static void test_rejections(void **state)
          "t.ini:5: [block] mas: unknown key (allowed: mass, driver_stiffness, normal_force, x_init, v_init, x_init_random, damping)"},
         {"mass = 1\n", "mass = 1\nmass = 2\n", "t.ini:5: [block] mass: duplicate key (first set at line 4)"},
         {"n_blocks = 1\n", "", "t.ini: [model] n_blocks: required key missing (allowed: 1 <= n_blocks <= 1000000, an integer)"},
-        {"mass = 1\n", "", "t.ini: [block] mass: required key missing (allowed: 0 < mass < inf kg)"},
+        {"mass = 1\n", "", "t.ini: [block] mass: required key missing (allowed: 0 <= mass < inf kg)"},
         {"driver_stiffness = 1e4\n", "", "t.ini: [block] driver_stiffness: required key missing (allowed: 0 <= driver_stiffness < inf N/m)"},
         {"law = coulomb\n", "", "t.ini: [friction] law: required key missing (allowed: coulomb, rate_state, carlson_langer, dieterich_ruina_aging, dieterich_ruina_slip)"},
         {"mu_s = 0.6\n", "", "t.ini: [friction] mu_s: required key missing (allowed: 0 <= mu_s < inf)"},
         {"velocity = 1e-3\n", "", "t.ini: [driver] velocity: required key missing (allowed: -inf < velocity < inf m/s)"},
         {"t_end = 5\n", "", "t.ini: [run] t_end: required key missing (allowed: 0 < t_end < inf s)"},
-        {"mass = 1\n", "mass = heavy\n", "t.ini:4: [block] mass: not a number: \"heavy\" (allowed: 0 < mass < inf kg)"},
+        {"mass = 1\n", "mass = heavy\n", "t.ini:4: [block] mass: not a number: \"heavy\" (allowed: 0 <= mass < inf kg)"},
         {"mass = 1\n", "mass = 2.0 # kg\n",
-         "t.ini:4: [block] mass: not a number: \"2.0 # kg\" (inline comments start with ';') (allowed: 0 < mass < inf kg)"},
+         "t.ini:4: [block] mass: not a number: \"2.0 # kg\" (inline comments start with ';') (allowed: 0 <= mass < inf kg)"},
         {"mass = 1\n", "mass = 1.5x\n", "t.ini:4: [block] mass: not a number: \"1.5x\""},
         {"mass = 1\n", "mass =\n", "t.ini:4: [block] mass: not a number: \"\""},
         {"mass = 1\n", "mass = nan\n", "t.ini:4: [block] mass: not a number: \"nan\""},
         {"mass = 1\n", "mass = inf\n", "t.ini:4: [block] mass: not a number: \"inf\""},
         {"mass = 1\n", "mass = -inf\n", "t.ini:4: [block] mass: not a number: \"-inf\""},
         {"mass = 1\n", "mass = 1e999\n", "t.ini:4: [block] mass: not a number: \"1e999\""},
-        {"mass = 1\n", "mass = -1\n", "t.ini:4: [block] mass: out of range, got -1 (allowed: 0 < mass < inf kg)"},
-        {"mass = 1\n", "mass = 0\n", "t.ini:4: [block] mass: out of range, got 0 (allowed: 0 < mass < inf kg)"},
+        {"mass = 1\n", "mass = -1\n", "t.ini:4: [block] mass: out of range, got -1 (allowed: 0 <= mass < inf kg)"},
+        {"mass = 1\n", "mass = 0\n", "t.ini:4: [block] mass: 0 (a quasi-dynamic block) needs a law without a stuck state"},
         {"driver_stiffness = 1e4\n", "driver_stiffness = -5\n",
          "t.ini:5: [block] driver_stiffness: out of range, got -5 (allowed: 0 <= driver_stiffness < inf N/m)"},
         {"n_blocks = 1\n", "n_blocks = 1.5\n", "t.ini:2: [model] n_blocks: not an integer: \"1.5\""},
@@ -509,7 +587,7 @@ static void test_rejections(void **state)
          "t.ini:9: [friction] mu_d: uniform(-0.1, 0.5) reaches outside the allowed range (allowed: 0 <= mu_d < inf)"},
         {"mass = 1\n", "mass = normal(-1, 0.1)\n", "t.ini:4: [block] mass: normal(-1, 0.1) drew -"},
         {"mass = 1\n", "mass = normal(-1, 0.1)\n",
-         "for block 0, outside the allowed range (allowed: 0 < mass < inf kg; narrow the distribution, or set "
+         "for block 0, outside the allowed range (allowed: 0 <= mass < inf kg; narrow the distribution, or set "
          "that block in [block.0])"},
         {"velocity = 1e-3\n", "velocity = uniform(1e-3, 2e-3)\n",
          "t.ini:11: [driver] velocity: a distribution is drawn per block: only keys of [block] and [friction] take one"},
@@ -618,10 +696,10 @@ static void test_overrides(void **state)
     assert_non_null(strstr(c->text, "; --set block.0.mass = 2\n"));
     bk_config_free(c);
 
-    const char *bad_value[] = {"block.mass=0"};
+    const char *bad_value[] = {"block.mass=-2"};
     assert_int_equal(bk_config_load_string(minimal_config, "t.ini", bad_value, 1, &c, &err), BK_ERR_CONFIG);
     assert_null(c);
-    assert_string_equal(err.message, "--set block.mass=0: [block] mass: out of range, got 0 (allowed: 0 < mass < inf kg)");
+    assert_string_equal(err.message, "--set block.mass=-2: [block] mass: out of range, got -2 (allowed: 0 <= mass < inf kg)");
     const char *malformed[] = {"blockmass=2"};
     assert_int_equal(bk_config_load_string(minimal_config, "t.ini", malformed, 1, &c, &err), BK_ERR_CONFIG);
     assert_non_null(strstr(err.message, "--set blockmass=2: expected section.key=value"));
@@ -757,7 +835,7 @@ static void test_warnings(void **state)
         {{"output.interval=0.03"}, 1, 0, NULL},
         {{"output.interval=0"}, 1, 0, NULL},
         /* The natural period is 2 pi / 100 s = 63 ms. */
-        {{"solver.max_step=0.1"}, 1, 1, "[solver] max_step = 0.1 s is longer than the fastest natural period (0.0628 s)"},
+        {{"solver.max_step=0.1"}, 1, 1, "[solver] max_step = 0.1 s is longer than the fastest damped oscillation's period (0.0628 s)"},
         {{"solver.max_step=0.05"}, 1, 0, NULL},
         {{"driver.velocity=1", "output.interval=0.05", "solver.max_step=0.1"}, 3, 3, "max_step"},
     };
@@ -823,7 +901,7 @@ static void test_reference(void **state)
     FILE *f = open_memstream(&buf, &len);
     bk_config_write_reference(f);
     fclose(f);
-    const char *expect[] = {"### [model]", "| `n_blocks` |", "| `mass` | kg | required | 0 < mass < inf kg |",
+    const char *expect[] = {"### [model]", "| `n_blocks` |", "| `mass` | kg | required | 0 <= mass < inf kg |",
                             "### [friction] law = coulomb", "| `mu_d` |", "| `t_end` | s |",
                             "| `interval` | s | t_end / 1000 |"};
     for (size_t k = 0; k < sizeof expect / sizeof expect[0]; ++k) {
@@ -847,6 +925,7 @@ int main(void)
         cmocka_unit_test(test_event_rows_auto),
         cmocka_unit_test(test_tolerated_forms),
         cmocka_unit_test(test_rejections),
+        cmocka_unit_test(test_quasi_dynamic),
         cmocka_unit_test(test_first_error_reported),
         cmocka_unit_test(test_out_of_range_draw_stays_the_error),
         cmocka_unit_test(test_overrides),

@@ -1,7 +1,9 @@
 /* Friction laws: one battery over every registered law (parameter tables, finiteness at the
  * limits, exact state evolution against the integrated state equation), then each law's
- * own values and limits, the paper law's steady state and degenerate printed form, and the
- * Rice-Ruina stability boundary of a block under Dieterich-Ruina friction. */
+ * own values and limits, the paper law's steady state and degenerate printed form, the
+ * Dieterich-Ruina laws' exact derivatives against difference quotients, each state law's
+ * relaxation time against its own state decay, and the Rice-Ruina stability boundary of a
+ * block under Dieterich-Ruina friction. */
 #include <float.h>
 #include <stdlib.h>
 #include <string.h>
@@ -263,6 +265,241 @@ static void test_dieterich_ruina(void **state)
     assert_close(rate[0], 0.0, 0, 0);
 }
 
+/* --- Dieterich-Ruina: exact derivatives of the sliding force ---------------------------- */
+
+/* a = 0.01, b = 0.015, Dc = 1e-5, f0 = 0.6, the given V0; theta_init = Dc / 1e-3. */
+static void dr_params(const bk_friction_law *law, double V0, double *p)
+{
+    law_params(law, p);
+    p[bk_friction_param_index(law, "V0")] = V0;
+}
+
+/* ln z = ln(|v| / (2 V0)) + (f0 + b ln(V0 theta / Dc)) / a, formed as the law forms it, so
+ * that the test knows which branch each point takes. */
+static double dr_log_scale(const bk_friction_law *law, const double *p, double theta)
+{
+    double a = p[bk_friction_param_index(law, "a")], b = p[bk_friction_param_index(law, "b")];
+    double Dc = p[bk_friction_param_index(law, "Dc")], V0 = p[bk_friction_param_index(law, "V0")];
+    double f0 = p[bk_friction_param_index(law, "f0")];
+    return (f0 + b * log(V0 * theta / Dc)) / a;
+}
+
+static double dr_log_z(const bk_friction_law *law, const double *p, double v, double theta)
+{
+    double V0 = p[bk_friction_param_index(law, "V0")];
+    return log(fabs(v) / (2.0 * V0)) + dr_log_scale(law, p, theta);
+}
+
+/* The sliding force as a function of the slip rate (vary_state 0) or of the state (1). */
+typedef struct force_slice {
+    const bk_friction_law *law;
+    const double *p;
+    double normal_force, slip_rate, theta;
+    int vary_state;
+} force_slice;
+
+static double slice_at(const force_slice *s, double x)
+{
+    double st[1] = {s->vary_state ? x : s->theta};
+    return s->law->sliding_force(s->p, s->normal_force, s->vary_state ? s->slip_rate : x, st);
+}
+
+/* Central differences at h, h/2, h/4, Richardson-extrapolated twice: error O(h^6). */
+static double richardson(const force_slice *s, double x, double h)
+{
+    double d[3];
+    for (int k = 0; k < 3; ++k, h *= 0.5)
+        d[k] = (slice_at(s, x + h) - slice_at(s, x - h)) / (2.0 * h);
+    double r0 = (4.0 * d[1] - d[0]) / 3.0, r1 = (4.0 * d[2] - d[1]) / 3.0;
+    return (16.0 * r1 - r0) / 15.0;
+}
+
+static double relative_error(double a, double b) { return fabs(a - b) / fabs(b); }
+
+/* dF/dv and dF/dtheta against extrapolated difference quotients of sliding_force, for both
+ * state laws, two reference velocities, states Dc/V from 1e-6 to 1e6 s and slip rates from
+ * 1e-45 to 10 m/s of either sign: all three branches (ln z < -20, between, > 20) agree to
+ * 1e-7 relative.  A wrong factor, sign or branch would miss by far more. */
+static void test_dieterich_ruina_derivatives(void **state)
+{
+    (void)state;
+    const bk_friction_law *laws[] = {&bk_friction_dieterich_ruina_aging, &bk_friction_dieterich_ruina_slip};
+    const double V0s[] = {1e-5, 1e-3}, N = 5e6, delta = 0.05, tol = 1e-7;
+    double worst_rate = 0.0, worst_state = 0.0;
+    size_t branch_hits[3] = {0, 0, 0}, points = 0;
+    for (size_t k = 0; k < 2; ++k) {
+        const bk_friction_law *law = laws[k];
+        assert_non_null(law->sliding_force_derivatives);
+        for (size_t iv = 0; iv < 2; ++iv) {
+            double p[BK_FRICTION_MAX_PARAMS];
+            dr_params(law, V0s[iv], p);
+            for (int te = -12; te <= 12; ++te) { /* theta = 1e-6 ... 1e6 s, half decades */
+                double theta = pow(10.0, 0.5 * te);
+                for (int re = -90; re <= 2; ++re) { /* |v| = 1e-45 ... 10 m/s, half decades */
+                    if (re < -60 && re % 10 != 0)
+                        continue; /* below 1e-30 m/s, every 5 decades */
+                    for (int sign = -1; sign <= 1; sign += 2) {
+                        double v = sign * pow(10.0, 0.5 * re), st[1] = {theta}, d_rate, d_state;
+                        law->sliding_force_derivatives(p, N, v, st, &d_rate, &d_state);
+                        double log_z = dr_log_z(law, p, v, theta);
+                        branch_hits[log_z < -20.0 ? 0 : log_z > 20.0 ? 2 : 1]++;
+                        force_slice by_rate = {law, p, N, v, theta, 0}, by_state = {law, p, N, v, theta, 1};
+                        double q_rate = richardson(&by_rate, v, delta * fabs(v));
+                        double q_state = richardson(&by_state, theta, delta * theta);
+                        double e_rate = relative_error(d_rate, q_rate), e_state = relative_error(d_state, q_state);
+                        if (!(e_rate <= tol && e_state <= tol))
+                            print_error("%s V0 %g: v = %g, theta = %g, ln z = %.3f\n", law->name, V0s[iv], v,
+                                        theta, log_z);
+                        assert_close(d_rate, q_rate, tol, 0);
+                        assert_close(d_state, q_state, tol, 0);
+                        worst_rate = fmax(worst_rate, e_rate);
+                        worst_state = fmax(worst_state, e_state);
+                        points++;
+                    }
+                }
+            }
+        }
+    }
+    print_message("%zu points (ln z < -20: %zu, between: %zu, > 20: %zu): worst relative error "
+                  "dF/dv %.2g, dF/dtheta %.2g\n",
+                  points, branch_hits[0], branch_hits[1], branch_hits[2], worst_rate, worst_state);
+    for (size_t b = 0; b < 3; ++b)
+        assert_true(branch_hits[b] > 10);
+}
+
+/* dF/dv even and dF/dtheta odd in v; at v = 0 dF/dtheta = 0 (F(0, theta) = 0) and dF/dv is
+ * both the difference quotient there and the limit of small v; values just either side of
+ * the branch switches at ln z = -20 and ln z = 20 agree. */
+static void test_dieterich_ruina_derivatives_limits(void **state)
+{
+    (void)state;
+    const bk_friction_law *laws[] = {&bk_friction_dieterich_ruina_aging, &bk_friction_dieterich_ruina_slip};
+    const double V0s[] = {1e-5, 1e-3}, thetas[] = {1e-6, 3e-3, 1.0, 1e6}, N = 5e6;
+    double worst_zero = 0.0, worst_limit = 0.0, worst_switch = 0.0;
+    for (size_t k = 0; k < 2; ++k) {
+        const bk_friction_law *law = laws[k];
+        for (size_t iv = 0; iv < 2; ++iv) {
+            double p[BK_FRICTION_MAX_PARAMS];
+            dr_params(law, V0s[iv], p);
+            for (size_t it = 0; it < 4; ++it) {
+                double theta = thetas[it], st[1] = {theta}, dr_pos, ds_pos, dr_neg, ds_neg;
+                /* Symmetry, exactly. */
+                const double rates[] = {1e-45, 1e-30, 1e-20, 1e-9, 1e-5, 1e-3, 1.0, 10.0};
+                for (size_t r = 0; r < 8; ++r) {
+                    law->sliding_force_derivatives(p, N, rates[r], st, &dr_pos, &ds_pos);
+                    law->sliding_force_derivatives(p, N, -rates[r], st, &dr_neg, &ds_neg);
+                    assert_true(dr_pos > 0.0 && ds_pos > 0.0);
+                    assert_close(dr_neg, dr_pos, 0, 0);
+                    assert_close(ds_neg, -ds_pos, 0, 0);
+                }
+                /* v = 0: z = v / v_c with v_c = 2 V0 e^(-psi / a), F = N a asinh(v / v_c). */
+                double v_c = 2.0 * V0s[iv] * exp(-dr_log_scale(law, p, theta));
+                double d_rate0, d_state0;
+                law->sliding_force_derivatives(p, N, 0.0, st, &d_rate0, &d_state0);
+                assert_close(d_state0, 0.0, 0, 0);
+                assert_close(d_rate0, N * 0.01 / v_c, 1e-12, 0);
+                force_slice by_rate = {law, p, N, 0.0, theta, 0};
+                double q = richardson(&by_rate, 0.0, 0.05 * v_c);
+                assert_close(d_rate0, q, 1e-9, 0);
+                worst_zero = fmax(worst_zero, relative_error(d_rate0, q));
+                /* Small v: dF/dv = d_rate0 / sqrt(1 + z^2), z = 1e-3 (between) to 1e-12 (ln z < -20). */
+                const double zs[] = {1e-3, 1e-6, 1e-8, 1e-12};
+                for (size_t iz = 0; iz < 4; ++iz) {
+                    double d_rate, d_state;
+                    law->sliding_force_derivatives(p, N, zs[iz] * v_c, st, &d_rate, &d_state);
+                    double limit = d_rate0 / sqrt(1.0 + zs[iz] * zs[iz]);
+                    assert_close(d_rate, limit, 1e-12, 0);
+                    worst_limit = fmax(worst_limit, relative_error(d_rate, limit));
+                }
+                /* Either side of ln z = +-20: slip rates 1e-12 apart straddling the switch. */
+                const double edges[] = {-20.0, 20.0};
+                for (size_t ie = 0; ie < 2; ++ie) {
+                    double v_edge = v_c * exp(edges[ie]);
+                    double below = v_edge * (1.0 - 1e-12), above = v_edge * (1.0 + 1e-12);
+                    assert_true(dr_log_z(law, p, below, theta) < edges[ie]);
+                    assert_true(dr_log_z(law, p, above, theta) > edges[ie]);
+                    double r_below, s_below, r_above, s_above;
+                    law->sliding_force_derivatives(p, N, below, st, &r_below, &s_below);
+                    law->sliding_force_derivatives(p, N, above, st, &r_above, &s_above);
+                    assert_close(r_above, r_below, 1e-8, 0);
+                    assert_close(s_above, s_below, 1e-8, 0);
+                    worst_switch = fmax(worst_switch, fmax(relative_error(r_above, r_below),
+                                                           relative_error(s_above, s_below)));
+                }
+            }
+        }
+    }
+    print_message("v = 0: dF/dv against its quotient %.2g, small v against d_rate(0) / sqrt(1 + z^2) %.2g; "
+                  "branch switches at ln z = +-20: worst relative jump %.2g\n",
+                  worst_zero, worst_limit, worst_switch);
+}
+
+/* --- relaxation times ------------------------------------------------------------------ */
+
+/* After dt from a small offset off steady state at speed v, the offset has shrunk by
+ * exp(-dt / tau) (for the slip law, the offset of ln theta); the linearised state equation
+ * has slope -1 / tau there. */
+static double check_relaxation(const bk_friction_law *law, const double *p, double speed, double steady)
+{
+    double tau = law->relaxation_time(p, speed), worst = 0.0;
+    int log_offset = law == &bk_friction_dieterich_ruina_slip;
+    const double offsets[] = {1e-3, -1e-3}, spans[] = {0.1, 1.0, 3.0};
+    for (size_t o = 0; o < 2; ++o)
+        for (size_t s = 0; s < 3; ++s) {
+            double theta0 = log_offset ? steady * exp(offsets[o]) : steady * (1.0 + offsets[o]);
+            double st[1] = {theta0};
+            law->state_advance(p, speed, spans[s] * tau, st);
+            double shrink = log_offset ? log(st[0] / steady) / log(theta0 / steady)
+                                       : (st[0] - steady) / (theta0 - steady);
+            assert_close(shrink, exp(-spans[s]), 1e-9, 0);
+            worst = fmax(worst, relative_error(shrink, exp(-spans[s])));
+        }
+    /* d(theta')/d(theta) at steady state = -1 / tau. */
+    double up[1] = {steady * (1.0 + 1e-6)}, down[1] = {steady * (1.0 - 1e-6)}, r_up[1], r_down[1];
+    law->state_rate(p, speed, up, r_up);
+    law->state_rate(p, speed, down, r_down);
+    double slope = (r_up[0] - r_down[0]) / (up[0] - down[0]);
+    assert_close(slope * tau, -1.0, 1e-6, 0);
+    worst = fmax(worst, fabs(slope * tau + 1.0));
+    return worst;
+}
+
+/* Dc / v for both Dieterich-Ruina laws, L0 / (B v) for the paper's law, each the decay time
+ * of the law's own state_advance; laws without state have neither relaxation time nor
+ * derivatives, and the paper's law leaves its derivatives to difference quotients. */
+static void test_relaxation_time(void **state)
+{
+    (void)state;
+    const double speeds[] = {1e-9, 2.385e-3, 1.0, 10.0};
+    double worst = 0.0;
+    const bk_friction_law *drs[] = {&bk_friction_dieterich_ruina_aging, &bk_friction_dieterich_ruina_slip};
+    for (size_t k = 0; k < 2; ++k) {
+        double p[BK_FRICTION_MAX_PARAMS];
+        law_params(drs[k], p);
+        assert_non_null(drs[k]->relaxation_time);
+        for (size_t s = 0; s < 4; ++s) {
+            assert_close(drs[k]->relaxation_time(p, speeds[s]), 1e-5 / speeds[s], 1e-15, 0);
+            worst = fmax(worst, check_relaxation(drs[k], p, speeds[s], 1e-5 / speeds[s]));
+        }
+    }
+    const bk_friction_law *rs = &bk_friction_rate_state;
+    double p[BK_FRICTION_MAX_PARAMS];
+    law_params(rs, p);
+    assert_non_null(rs->relaxation_time);
+    assert_null(rs->sliding_force_derivatives);
+    for (size_t s = 0; s < 4; ++s) {
+        assert_close(rs->relaxation_time(p, speeds[s]), 2e-5 / (4.6 * speeds[s]), 1e-15, 0);
+        worst = fmax(worst, check_relaxation(rs, p, speeds[s], 2e-5 / speeds[s]));
+    }
+    print_message("state decay against exp(-t / relaxation_time): worst relative error %.2g\n", worst);
+    assert_null(bk_friction_coulomb.relaxation_time);
+    assert_null(bk_friction_coulomb.sliding_force_derivatives);
+    assert_null(bk_friction_carlson_langer.relaxation_time);
+    assert_null(bk_friction_carlson_langer.sliding_force_derivatives);
+    for (const bk_friction_law *const *l = bk_friction_laws(); *l; ++l)
+        assert_int_equal((*l)->n_state > 0, (*l)->relaxation_time != NULL);
+}
+
 /* --- parameter validation through the config loader ------------------------------------ */
 
 static void test_validation(void **state)
@@ -380,6 +617,9 @@ int main(void)
         cmocka_unit_test(test_rate_state_limits),
         cmocka_unit_test(test_carlson_langer),
         cmocka_unit_test(test_dieterich_ruina),
+        cmocka_unit_test(test_dieterich_ruina_derivatives),
+        cmocka_unit_test(test_dieterich_ruina_derivatives_limits),
+        cmocka_unit_test(test_relaxation_time),
         cmocka_unit_test(test_validation),
         cmocka_unit_test(test_rice_ruina),
     };

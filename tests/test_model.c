@@ -1,5 +1,6 @@
 /* Chain and lattice forces and energies: hand-computed forces for every boundary, energy
- * gradients against forces, the frequency bound against GSL's eigenvalues. */
+ * gradients against forces, the frequency bound against GSL's eigenvalues, the step time
+ * scale (damped period, else friction relaxation time) against closed forms. */
 #include <gsl/gsl_eigen.h>
 #include <gsl/gsl_matrix.h>
 #include <stdlib.h>
@@ -274,6 +275,164 @@ static void test_frequency_bound(void **state)
     }
 }
 
+/* --- the default step limit's time scale ---------------------------------------------- */
+
+#define TWO_PI (2.0 * 3.14159265358979323846)
+
+/* Give block i a stateful law with its defaults and the keys given (NULL-terminated). */
+static void set_law(bk_block *b, const bk_friction_law *law, const char *const *keys, const double *values)
+{
+    b->law = law;
+    for (size_t k = 0; k < law->n_params; ++k)
+        b->friction_params[k] = law->params[k].default_value;
+    for (size_t k = 0; keys[k]; ++k) {
+        int i = bk_friction_param_index(law, keys[k]);
+        assert_true(i >= 0);
+        b->friction_params[i] = values[k];
+    }
+}
+
+static const char *const dr_keys[] = {"a", "b", "Dc", "V0", "f0", "theta_init", NULL};
+
+/* Undamped: exactly 2 pi / bk_model_max_angular_frequency (and bk_model_damped_period), for
+ * chains and lattices of every boundary; dashpots beside the coupling springs do not change it. */
+static void test_step_time_scale_undamped(void **state)
+{
+    (void)state;
+    const bk_boundary boundaries[] = {BK_BOUNDARY_FREE, BK_BOUNDARY_FIXED, BK_BOUNDARY_PERIODIC};
+    const size_t shapes[][2] = {{1, 1}, {1, 2}, {1, 5}, {3, 4}, {2, 3}};
+    size_t checked = 0;
+    for (size_t br = 0; br < 3; ++br)
+        for (size_t bc = 0; bc < 3; ++bc)
+            for (size_t sh = 0; sh < sizeof shapes / sizeof shapes[0]; ++sh) {
+                bk_model *m = make_lattice(shapes[sh][0], shapes[sh][1], boundaries[br], boundaries[bc]);
+                double expected = TWO_PI / bk_model_max_angular_frequency(m);
+                double got = bk_model_step_time_scale(m);
+                if (got != expected)
+                    print_error("%zu x %zu: %.17g != %.17g\n", shapes[sh][0], shapes[sh][1], got, expected);
+                assert_true(got == expected);
+                assert_true(bk_model_damped_period(m) == expected);
+                m->coupling_damping = 1e3;
+                assert_true(bk_model_step_time_scale(m) == expected);
+                bk_model_free(m);
+                checked++;
+            }
+    bk_model *one = make_chain(1, BK_BOUNDARY_FREE, BK_SPRING_LINEAR); /* no coupling: sqrt(k / m) */
+    assert_close(bk_model_step_time_scale(one), TWO_PI / sqrt(1e4 / 1.0), 1e-15, 0);
+    bk_model_free(one);
+    print_message("%zu undamped models: step time scale == 2 pi / max angular frequency, bit for bit\n", checked);
+}
+
+/* Underdamped blocks: 2 pi / max_i sqrt((k_i + 2 count_i kc) / m_i - (eta_i / 2 m_i)^2). */
+static void test_step_time_scale_underdamped(void **state)
+{
+    (void)state;
+    /* One block, m = 2 kg, k = 1e4 N/m, eta = 50 N s/m: 2 pi / sqrt(5000 - 12.5^2). */
+    bk_model *one = make_chain(1, BK_BOUNDARY_FREE, BK_SPRING_LINEAR);
+    one->blocks[0].mass = 2.0;
+    one->blocks[0].damping = 50.0;
+    double expected = TWO_PI / sqrt(1e4 / 2.0 - (50.0 / 4.0) * (50.0 / 4.0));
+    assert_close(bk_model_step_time_scale(one), expected, 1e-15, 0);
+    assert_true(bk_model_damped_period(one) == bk_model_step_time_scale(one));
+    print_message("underdamped block: %.17g s, closed form %.17g s\n", bk_model_step_time_scale(one), expected);
+    /* Nearly critical: eta = 199 on m = 1, k = 1e4 leaves sqrt(1e4 - 99.5^2) = sqrt(99.75). */
+    one->blocks[0].mass = 1.0;
+    one->blocks[0].damping = 199.0;
+    assert_close(bk_model_step_time_scale(one), TWO_PI / sqrt(99.75), 1e-12, 0);
+    bk_model_free(one);
+    /* Three blocks between walls (two couplings each): rows 19540 / 1, 20540 / 1.25 = 16432,
+     * 21540 / 1.5 = 14360 per s^2.  Damping block 0 by eta = 200 takes 100^2 off its row,
+     * leaving 9540: the fastest oscillation is now block 1's, undamped. */
+    bk_model *m = make_chain(3, BK_BOUNDARY_FIXED, BK_SPRING_LINEAR);
+    double kc = m->coupling_stiffness;
+    assert_close(bk_model_step_time_scale(m), TWO_PI / sqrt(1e4 + 4.0 * kc), 1e-15, 0);
+    m->blocks[0].damping = 200.0;
+    assert_close(bk_model_step_time_scale(m), TWO_PI / sqrt((1.1e4 + 4.0 * kc) / 1.25), 1e-15, 0);
+    /* Damping block 1 by eta = 100: 16432 - (100 / 2.5)^2 = 14832, still above block 2's. */
+    m->blocks[1].damping = 100.0;
+    double rate1 = (1.1e4 + 4.0 * kc) / 1.25 - (100.0 / 2.5) * (100.0 / 2.5);
+    assert_close(bk_model_step_time_scale(m), TWO_PI / sqrt(rate1), 1e-15, 0);
+    /* And by eta = 150: 16432 - 60^2 = 12832, below block 2's undamped 14360. */
+    m->blocks[1].damping = 150.0;
+    assert_close(bk_model_step_time_scale(m), TWO_PI / sqrt((1.2e4 + 4.0 * kc) / 1.5), 1e-15, 0);
+    bk_model_free(m);
+}
+
+/* Blocks without mass never oscillate: skipped, however stiff. */
+static void test_step_time_scale_massless(void **state)
+{
+    (void)state;
+    bk_model *m = make_chain(2, BK_BOUNDARY_FREE, BK_SPRING_LINEAR);
+    m->blocks[0].mass = 0.0;
+    m->blocks[0].driver_stiffness = 1e12;
+    double kc = m->coupling_stiffness;
+    /* Block 1: m = 1.25, k = 1.1e4, one coupling. */
+    assert_close(bk_model_step_time_scale(m), TWO_PI / sqrt((1.1e4 + 2.0 * kc) / 1.25), 1e-15, 0);
+    m->blocks[0].damping = 5.0;
+    assert_close(bk_model_step_time_scale(m), TWO_PI / sqrt((1.1e4 + 2.0 * kc) / 1.25), 1e-15, 0);
+    bk_model_free(m);
+    /* All massless, Coulomb: no scale at all. */
+    bk_model *none = make_chain(2, BK_BOUNDARY_FIXED, BK_SPRING_LINEAR);
+    none->blocks[0].mass = none->blocks[1].mass = 0.0;
+    none->driver.velocity = 1e-3;
+    assert_true(isinf(bk_model_step_time_scale(none)) && bk_model_step_time_scale(none) > 0.0);
+    /* With a state law, the massless block's relaxation time Dc / |V|. */
+    const double dr[] = {0.01, 0.015, 4e-6, 1e-6, 0.6, 1.0};
+    set_law(&none->blocks[1], &bk_friction_dieterich_ruina_aging, dr_keys, dr);
+    bk_model_finalize(none);
+    assert_close(bk_model_step_time_scale(none), 4e-6 / 1e-3, 1e-15, 0);
+    bk_model_free(none);
+}
+
+/* Every block overdamped by its own dashpot (or critically damped): the shortest relaxation
+ * time of a friction state at |driver velocity|: Dc / |V| (Dieterich-Ruina), L0 / (B |V|)
+ * (the paper's law); INFINITY without a state law or with the driver at rest. */
+static void test_step_time_scale_overdamped(void **state)
+{
+    (void)state;
+    /* One block, m = 1, k = 1e4: critical damping is eta = 2 sqrt(k m) = 200. */
+    bk_model *one = make_chain(1, BK_BOUNDARY_FREE, BK_SPRING_LINEAR);
+    one->driver.velocity = -2.5e-3;
+    one->blocks[0].damping = 300.0;
+    assert_true(isinf(bk_model_step_time_scale(one)) && bk_model_step_time_scale(one) > 0.0); /* Coulomb */
+    const double dr[] = {0.01, 0.015, 1e-5, 1e-6, 0.6, 1.0};
+    set_law(&one->blocks[0], &bk_friction_dieterich_ruina_slip, dr_keys, dr);
+    bk_model_finalize(one);
+    assert_close(bk_model_step_time_scale(one), 1e-5 / 2.5e-3, 1e-15, 0);
+    assert_true(isinf(bk_model_damped_period(one)));
+    print_message("overdamped block, slip law: %.17g s, Dc / |V| = %.17g s\n", bk_model_step_time_scale(one),
+                  1e-5 / 2.5e-3);
+    one->blocks[0].damping = 200.0; /* critical: k / m - (eta / 2m)^2 = 0, no oscillation */
+    assert_true(isinf(bk_model_damped_period(one)));
+    assert_close(bk_model_step_time_scale(one), 1e-5 / 2.5e-3, 1e-15, 0);
+    one->blocks[0].damping = 199.0; /* just under: it oscillates, slowly */
+    assert_close(bk_model_step_time_scale(one), TWO_PI / sqrt(99.75), 1e-12, 0);
+    one->blocks[0].damping = 300.0;
+    one->driver.velocity = 0.0; /* a driver at rest sets no relaxation time */
+    assert_true(isinf(bk_model_step_time_scale(one)) && bk_model_step_time_scale(one) > 0.0);
+    bk_model_free(one);
+    /* Three blocks, all overdamped: the shortest of Dc / |V| (aging), L0 / (B |V|) (paper's
+     * law), and nothing from a Coulomb block. */
+    bk_model *m = make_chain(3, BK_BOUNDARY_FREE, BK_SPRING_LINEAR);
+    m->driver.velocity = 1e-3;
+    for (size_t i = 0; i < 3; ++i)
+        m->blocks[i].damping = 1e4;
+    set_law(&m->blocks[0], &bk_friction_dieterich_ruina_aging, dr_keys, dr);
+    const char *const rs_keys[] = {"L0", "B", "v_theta_ref", "theta_init", NULL};
+    const double rs[] = {2e-5, 4.6, 100.0, 0.02};
+    set_law(&m->blocks[1], &bk_friction_rate_state, rs_keys, rs);
+    bk_model_finalize(m);
+    assert_close(bk_model_step_time_scale(m), 2e-5 / (4.6 * 1e-3), 1e-15, 0); /* 4.35e-3 < 1e-2 */
+    const double rs_slow[] = {2e-4, 4.6, 100.0, 0.2};
+    set_law(&m->blocks[1], &bk_friction_rate_state, rs_keys, rs_slow);
+    assert_close(bk_model_step_time_scale(m), 1e-5 / 1e-3, 1e-15, 0); /* 1e-2 < 4.35e-2 */
+    /* One block back under its critical damping: the oscillation wins again. */
+    m->blocks[2].damping = 0.0;
+    double kc = m->coupling_stiffness;
+    assert_close(bk_model_step_time_scale(m), TWO_PI / sqrt((1.2e4 + 2.0 * kc) / 1.5), 1e-15, 0);
+    bk_model_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -286,6 +445,10 @@ int main(void)
         cmocka_unit_test(test_lattice_energy_gradient),
         cmocka_unit_test(test_kinetic_energy),
         cmocka_unit_test(test_frequency_bound),
+        cmocka_unit_test(test_step_time_scale_undamped),
+        cmocka_unit_test(test_step_time_scale_underdamped),
+        cmocka_unit_test(test_step_time_scale_massless),
+        cmocka_unit_test(test_step_time_scale_overdamped),
     };
     return cmocka_run_group_tests_name("model", tests, NULL, NULL);
 }

@@ -55,6 +55,15 @@ typedef struct bk_friction_law {
     /* Exact state after dt (s) at constant |slip rate| speed (m/s, 0 for a hold), in place;
      * NULL when n_state == 0.  Prescribed-motion scenes rely on it. */
     void (*state_advance)(const double *params, double speed, double dt, double *state);
+    /* Time (s) the state takes to relax toward steady sliding at |slip rate| speed > 0 (the
+     * law's own slip time scale, e.g. Dc / v); NULL when n_state == 0.  Default step limits
+     * use it where no oscillation sets one. */
+    double (*relaxation_time)(const double *params, double speed);
+    /* d sliding_force / d slip_rate (N s/m) and / d state[0] (N per state unit) at slip_rate,
+     * exact; NULL: callers take difference quotients.  Blocks without mass need it (their
+     * slip rate follows the force balance, whose time derivative it enters). */
+    void (*sliding_force_derivatives)(const double *params, double normal_force, double slip_rate,
+                                      const double *state, double *d_rate, double *d_state);
 } bk_friction_law;
 
 /* Registry: the law named `name`, or NULL. */

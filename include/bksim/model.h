@@ -86,6 +86,15 @@ double bk_model_elastic_energy(const bk_model *model, const double *x, double dr
 double bk_model_kinetic_energy(const bk_model *model, const double *v);
 /* Upper bound on the chain's highest natural angular frequency (rad/s), Gershgorin. */
 double bk_model_max_angular_frequency(const bk_model *model);
+/* The period of the fastest damped oscillation (s), bounded as bk_model_max_angular_frequency
+ * does but with each block's own dashpot, 2 pi / sqrt(k_i / m_i - (eta_i / 2 m_i)^2)
+ * (dashpots between blocks only damp further); INFINITY when no block oscillates (each
+ * overdamped by its dashpot, or without mass).  Undamped: 2 pi / bk_model_max_angular_frequency. */
+double bk_model_damped_period(const bk_model *model);
+/* The time scale default step limits come from (s): bk_model_damped_period, or where no block
+ * oscillates the shortest relaxation time of a friction state at the driver's speed;
+ * INFINITY when neither exists. */
+double bk_model_step_time_scale(const bk_model *model);
 /* Directions with coupling partners: 2 on a chain (left, right), 4 on a lattice (or a row
  * between fixed walls above and below). */
 size_t bk_model_directions(const bk_model *model);

@@ -19,7 +19,7 @@ typedef struct bk_solver_options {
     double rtol;            /* relative tolerance; default 1e-8 */
     double atol_x;          /* m; NaN = auto (rtol * 1e-3 * slip length scale) */
     double atol_v;          /* m/s; NaN = auto (rtol * 1e-3 * velocity scale) */
-    double max_step;        /* s; NaN = auto (1/8 of the fastest natural period) */
+    double max_step;        /* s; NaN = auto (1/8 of bk_model_step_time_scale) */
     long max_steps;         /* solver steps allowed between two output rows; default 100000 */
     int detect_velocity_extrema; /* locate slip-rate minima to catch hidden stops; default 1 */
     long max_transitions_per_instant; /* per block, before a chattering error; default 100 */
@@ -27,7 +27,7 @@ typedef struct bk_solver_options {
                                NaN = auto (1e-6 of the fastest natural period) */
     double min_step;        /* s: a step below this is an error; 0 = no limit (default) */
     char arkode_table[48];  /* ARKODE Butcher table of arkode_erk / arkode_dirk; "default":
-                               the method's own (Zonneveld 5_3_4, SDIRK 5_3_4) */
+                               the method's own (Zonneveld 5_3_4, ESDIRK43I6L2SA 6_3_4) */
 } bk_solver_options;
 
 typedef struct bk_ode_problem {

@@ -62,6 +62,31 @@ static double sliding_force(const double *p, double normal_force, double slip_ra
     return copysign(normal_force * p[A] * magnitude, slip_rate);
 }
 
+/* With z = v / (2 V0) e^(psi / a): dF/dv = N a z / (v sqrt(1 + z^2)), which at v = 0 is
+ * N a e^(psi / a) / (2 V0); dF/dtheta = N b z / (theta sqrt(1 + z^2)).  z / sqrt(1 + z^2)
+ * is taken from log z, as z itself overflows at creep rates far below V0 e^(-f0 / a). */
+static void sliding_force_derivatives(const double *p, double normal_force, double slip_rate,
+                                      const double *state, double *d_rate, double *d_state)
+{
+    double theta = state[0] > 0.0 ? state[0] : DBL_MIN;
+    double log_scale = (p[F0] + p[B] * log(p[V_REF] * theta / p[DC])) / p[A];
+    if (slip_rate == 0.0) {
+        *d_rate = normal_force * p[A] * exp(log_scale) / (2.0 * p[V_REF]);
+        *d_state = 0.0;
+        return;
+    }
+    double log_z = log(fabs(slip_rate) / (2.0 * p[V_REF])) + log_scale;
+    if (log_z < -20.0) { /* z / sqrt(1 + z^2) = z to rounding */
+        *d_rate = normal_force * p[A] * exp(log_scale) / (2.0 * p[V_REF]);
+        *d_state = copysign(normal_force * p[B] * exp(log_z) / theta, slip_rate);
+        return;
+    }
+    /* z / sqrt(1 + z^2) = 1 / sqrt(1 + z^-2) */
+    double ratio = log_z > 20.0 ? 1.0 : 1.0 / sqrt(1.0 + exp(-2.0 * log_z));
+    *d_rate = normal_force * p[A] * ratio / fabs(slip_rate);
+    *d_state = copysign(normal_force * p[B] * ratio / theta, slip_rate);
+}
+
 static void aging_rate(const double *p, double speed, const double *state, double *rate)
 {
     rate[0] = 1.0 - speed * state[0] / p[DC];
@@ -94,6 +119,9 @@ static void slip_advance(const double *p, double speed, double dt, double *state
     state[0] = steady * exp(log(state[0] / steady) * exp(-speed * dt / p[DC]));
 }
 
+/* Both state laws relax as exp(-v t / Dc) near steady state. */
+static double relaxation_time(const double *p, double speed) { return p[DC] / speed; }
+
 #define DIETERICH_RUINA(var, law_name, law_doc, rate_fn, advance_fn)                               \
     const bk_friction_law var = {                                                                  \
         .name = law_name,                                                                          \
@@ -109,6 +137,8 @@ static void slip_advance(const double *p, double speed, double dt, double *state
         .state_rate = rate_fn,                                                                     \
         .state_init = state_init,                                                                  \
         .state_advance = advance_fn,                                                               \
+        .relaxation_time = relaxation_time,                                                        \
+        .sliding_force_derivatives = sliding_force_derivatives,                                    \
     }
 
 DIETERICH_RUINA(bk_friction_dieterich_ruina_aging, "dieterich_ruina_aging",

@@ -118,6 +118,9 @@ static void state_advance(const double *p, double speed, double dt, double *stat
     state[0] = (state[0] - steady) * exp(-(speed / p[L0]) * p[B] * dt) + steady;
 }
 
+/* Eq. 5: the state relaxes as exp(-(v / L0) B t). */
+static double relaxation_time(const double *p, double speed) { return p[L0] / (p[B] * speed); }
+
 const bk_friction_law bk_friction_rate_state = {
     .name = "rate_state",
     .doc = "the founding paper's rate-and-state law, eqs. 1-4 (NOTES.md 1: g's denominator uses v_theta_ref, default v0)",
@@ -132,4 +135,5 @@ const bk_friction_law bk_friction_rate_state = {
     .state_rate = state_rate,
     .state_init = state_init,
     .state_advance = state_advance,
+    .relaxation_time = relaxation_time,
 };

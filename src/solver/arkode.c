@@ -3,13 +3,47 @@
  * default order-4 pair), a diagonally implicit method and an additive (IMEX) pair, the last
  * two with Newton iteration and a dense or band direct linear solver.
  *
+ * The implicit methods meet stiffness far beyond what a step resolves: a rate-and-state
+ * block's slip rate relaxes onto its force balance at -(d F/d v + damping) / m, 1e12-1e17
+ * 1/s between events for masses of 1e-5-1 kg (d F/d v = a N / v), so h |d f/d y| reaches
+ * 1e8-1e15 and the slip rate is, to the tolerance, an algebraic variable.  Three settings
+ * follow (issue 32):
+ *  - arkode_dirk's own table is Kennedy & Carpenter's ESDIRK4(3I)6L[2]SA
+ *    (ARKODE_ESDIRK43I6L2SA_6_3_4): stiffly accurate, stage order 2, method and embedding
+ *    both L-stable.  ARKStep's default order-4 DIRK, SDIRK 5_3_4 (Hairer & Wanner's SDIRK4),
+ *    has stage order 1 and an embedding whose stability function is 3.3 at infinity: its
+ *    error estimate on a variable that sits on its slow manifold does not fall with h (the
+ *    QDYN spring-block failed its error test at h = 5e-10 s within the first millisecond,
+ *    at every mass; with the two settings below it still stalled at t = 170 s after 1.2e6
+ *    steps, where cvode_bdf takes 4.4e4 for the 300 s at rtol 1e-8).  Of the 15 tables
+ *    tried, ESDIRK4(3I)6L[2]SA took the fewest steps there (5.6e3 at rtol 1e-8,
+ *    1.7e4 at 1e-10; ESDIRK4(3)6L[2]SA 2.9e4 and 1.4e5; the order-5 ESDIRKs and Kvaerno
+ *    7_4_5 stalled in the first 0.01 s).  SDIRK 5_3_4 stays selectable ([solver]
+ *    arkode_table).
+ *  - Stage derivatives are deduced from the stage equation, f_i = (z_i - a_i) / (h a_ii)
+ *    (ARKStepSetDeduceImplicitRhs), not evaluated as f(z_i): the evaluation multiplies
+ *    the Newton iteration's residual by |d f/d y|, and that amplified residual fed both the
+ *    step and its error estimate (SUNDIALS' own advice when h a_ii L > 1, ARKODE guide
+ *    "Nonlinear solver methods").  The Hermite dense output reads the last (deduced) stage
+ *    derivative as f at the step's end (the tables here end with c = 1).
+ *  - Newton starts from the previous step's dense output extrapolated to the stage time
+ *    (predictor 1, "maximum order") instead of y_n: the slip rate grows or decays by orders
+ *    of magnitude within a step around events, and from y_n, whose friction Jacobian
+ *    (a N / v) is then off by as much, three iterations did not converge: convergence
+ *    failures, not accuracy, held the step (ESDIRK4(3I) on the QDYN block at rtol 1e-8:
+ *    107507 steps from y_n, 5646 with the predictor).
+ *
  * IMEX split (arkode_imex, Kennedy & Carpenter's ARK4(3)6L[2]SA): the problem's
  * rhs_split gives the friction terms (stiff: the direct effect at low slip rates, the
  * state's relaxation at small L0) to the ESDIRK half, with their own Jacobian
  * (jacobian_implicit), and the springs, kinematics and energy quadratures to the explicit
  * half.  ARKODE asks for both halves at each stage point; one rhs_split call, cached per
  * (t, y), serves both.  A problem without a split runs the whole right-hand side
- * implicitly, as arkode_dirk does but with the ARK pair's ESDIRK table.
+ * implicitly, as arkode_dirk does but with the ARK pair's ESDIRK table.  The split needs an
+ * underdamped block: where friction or dashpots overdamp it (rate-and-state, d F/d v =
+ * a N / v), the spring term k x / m left in the explicit half is the stiff one, and the
+ * step is held to ~30 sqrt(rtol m / k) (the QDYN block: 2.5e-9 s at 1e-3 kg, 7e-8 s at
+ * 1 kg, rtol 1e-8), whatever the implicit half does (issue 32).
  *
  * Dense output and root finding are ARKODE's own (Hermite interpolation of the step,
  * roots located on it); the state returned at a root is at ARKODE's upper bracket, just
@@ -45,7 +79,7 @@ typedef struct ark_variant {
 static const ark_variant variant_bs23 = {KIND_EXPLICIT, ARKODE_BOGACKI_SHAMPINE_4_2_3, ARKODE_DIRK_NONE, 0};
 static const ark_variant variant_dp45 = {KIND_EXPLICIT, ARKODE_DORMAND_PRINCE_7_4_5, ARKODE_DIRK_NONE, 0};
 static const ark_variant variant_erk = {KIND_EXPLICIT, ARKODE_ZONNEVELD_5_3_4, ARKODE_DIRK_NONE, 1};
-static const ark_variant variant_dirk = {KIND_IMPLICIT, ARKODE_ERK_NONE, ARKODE_SDIRK_5_3_4, 1};
+static const ark_variant variant_dirk = {KIND_IMPLICIT, ARKODE_ERK_NONE, ARKODE_ESDIRK43I6L2SA_6_3_4, 1};
 static const ark_variant variant_imex = {KIND_IMEX, ARKODE_ARK436L2SA_ERK_6_3_4, ARKODE_ARK436L2SA_DIRK_6_3_4, 0};
 
 /* The tables [solver] arkode_table selects.  Knoth-Wolke 3_3 is left out: it has no
@@ -336,6 +370,12 @@ static int build_objects(arkode_backend *ark, size_t n, double t0, const double 
          * band [1, 1.5], so this costs a Jacobian per change of h, not per step. */
         if ((flag = ARKStepSetDeltaGammaMax(ark->arkode, 1e-9)) != ARK_SUCCESS)
             return fail(ark, err, "ARKStepSetDeltaGammaMax", flag);
+        /* Stage derivatives from the stage equations and Newton from the extrapolated
+         * dense output: see the top of the file. */
+        if ((flag = ARKStepSetDeduceImplicitRhs(ark->arkode, SUNTRUE)) != ARK_SUCCESS)
+            return fail(ark, err, "ARKStepSetDeduceImplicitRhs", flag);
+        if ((flag = ARKStepSetPredictorMethod(ark->arkode, 1)) != ARK_SUCCESS)
+            return fail(ark, err, "ARKStepSetPredictorMethod", flag);
     }
     base->n = n;
     return BK_OK;
@@ -470,8 +510,9 @@ const bk_solver_backend bk_solver_arkode_erk = ARKODE_BACKEND(
     "[solver] arkode_table chosen: non-stiff");
 const bk_solver_backend bk_solver_arkode_dirk = ARKODE_BACKEND(
     "arkode_dirk", create_dirk, check_dirk,
-    "ARKODE diagonally implicit Runge-Kutta, SDIRK 4(3) L-stable (ARKStep's default order-4 "
-    "DIRK) or the [solver] arkode_table chosen; Newton with dense/band direct solver: stiff");
+    "ARKODE diagonally implicit Runge-Kutta, ESDIRK 4(3I) 6 stages, L-stable, stiffly accurate "
+    "(Kennedy & Carpenter) or the [solver] arkode_table chosen; Newton with dense/band direct "
+    "solver: stiff");
 const bk_solver_backend bk_solver_arkode_imex = ARKODE_BACKEND(
     "arkode_imex", create_imex, NULL,
     "ARKODE additive ARK4(3)6L[2]SA: friction implicit (Newton, dense/band direct solver), "

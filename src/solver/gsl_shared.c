@@ -16,6 +16,9 @@
 typedef struct scaled_control {
     double eps_abs, eps_rel;
     const double *scale;
+    /* errlevel reports stiff_factor D_i for a component with h stiffness_i > 1 (NULL: none) */
+    const double *stiffness;
+    double stiff_factor;
 } scaled_control;
 
 static void *control_alloc(void)
@@ -62,9 +65,10 @@ static int control_hadjust(void *state, size_t dim, unsigned int ord, const doub
 static int control_errlevel(void *state, double y, double dydt, double h, size_t ind, double *errlev)
 {
     (void)dydt;
-    (void)h;
     const scaled_control *c = state;
     *errlev = c->eps_rel * fabs(y) + c->eps_abs * c->scale[ind];
+    if (c->stiffness && fabs(h) * c->stiffness[ind] > 1.0)
+        *errlev *= c->stiff_factor;
     return *errlev > 0.0 ? GSL_SUCCESS : GSL_ESANITY;
 }
 
@@ -140,4 +144,16 @@ void bk_gsl_control_weights(gsl_odeiv2_control *control, double eps_abs, double 
     c->eps_abs = eps_abs;
     c->eps_rel = eps_rel;
     c->scale = scale;
+}
+
+gsl_odeiv2_control *bk_gsl_control_alloc(void)
+{
+    return gsl_odeiv2_control_alloc(&scaled_control_type);
+}
+
+void bk_gsl_control_stiff_errlevel(gsl_odeiv2_control *control, const double *stiffness, double factor)
+{
+    scaled_control *c = control->state;
+    c->stiffness = stiffness;
+    c->stiff_factor = factor;
 }
