@@ -44,7 +44,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         /* Every value finite and in range, derived ones (normal_force = mass * gravity) too. */
         for (size_t i = 0; i < m->n_blocks; ++i) {
             const bk_block *b = &m->blocks[i];
-            if (!b->law || !(b->mass > 0.0) || !isfinite(b->mass) || !(b->normal_force > 0.0) ||
+            /* A block without mass (quasi-dynamic) creeps, with a dashpot to bound it. */
+            if (b->mass == 0.0 && (!b->law || b->law->static_threshold || !(b->damping > 0.0)))
+                abort();
+            if (!b->law || !(b->mass >= 0.0) || !isfinite(b->mass) || !(b->normal_force > 0.0) ||
                 !isfinite(b->normal_force) || !isfinite(b->driver_stiffness) || !isfinite(b->x_init) ||
                 !isfinite(b->v_init) || !(b->damping >= 0.0) || !isfinite(b->damping))
                 abort();
