@@ -228,8 +228,9 @@ int bk_run_island_event(run_ctx *ctx, size_t id)
     /* The energy quadratures run on when the integration does. */
     if (!through)
         bk_energy_add(&ctx->closed, &increments);
-    /* Every root restarts the island.  A minimum that hid no stop disarms its root until the
-     * block decelerates again, so the restart does not begin on a zero of it. */
+    /* Every root but a threshold crossing restarts the island.  A minimum that hid no stop
+     * disarms its root until the block decelerates again, so the restart does not begin on a
+     * zero of it. */
     if (isl->hidden_block == SIZE_MAX)
         for (size_t k = 0; k < island->len; ++k)
             if (isl->found[R * k + BK_ROOT_EXTREMUM])
