@@ -206,26 +206,23 @@ static void friction_derivatives(const bk_scene *scene, size_t i, double slip_ra
  * the balance itself (balance_velocity), to rounding.  IDA keeps the balance
  * as the algebraic row it is (Phi in the velocity row, differential_id 0). */
 
-/* The springs' force on block i, and its rate of change (N, N/s). */
-static void spring_load(const bk_island *island, double t, const double *y, size_t i, double *force,
-                        double *rate)
+/* The rate of change of the springs' force on block i (N/s). */
+static double spring_load_rate(const bk_island *island, const double *y, size_t i)
 {
     const bk_scene *scene = island->scene;
     const bk_model *model = scene->model;
-    double driver_pos = bk_driver_segment_position(&model->driver, island->driver_segment, t);
     double driver_speed = bk_driver_segment_velocity(&model->driver, island->driver_segment);
-    double x_i = position(island, y, (long)i), v_i = velocity(island, y, (long)i);
-    *force = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i);
+    double v_i = velocity(island, y, (long)i);
     int taut = model->spring == BK_SPRING_LINEAR || scene->taut[i];
-    double r = taut ? model->blocks[i].driver_stiffness * (driver_speed - v_i) : 0.0;
+    double rate = taut ? model->blocks[i].driver_stiffness * (driver_speed - v_i) : 0.0;
     double kc = model->coupling_stiffness;
     if (kc != 0.0) {
         const long *partner = bk_scene_partners(scene, i);
         for (size_t d = 0; d < scene->n_directions; ++d)
             if (partner[d] != -1)
-                r += kc * (velocity(island, y, partner[d]) - v_i);
+                rate += kc * (velocity(island, y, partner[d]) - v_i);
     }
-    *rate = r;
+    return rate;
 }
 
 /* The slip rate of block i (without mass) on its force balance, bracketed Newton to
@@ -235,8 +232,9 @@ static double balance_velocity(const bk_island *island, double t, const double *
     const bk_scene *scene = island->scene;
     const bk_block *b = &scene->model->blocks[i];
     const double *state = block_state(island, y, i);
-    double load, rate;
-    spring_load(island, t, y, i, &load, &rate);
+    double driver_pos = bk_driver_segment_position(&scene->model->driver, island->driver_segment, t);
+    double x_i = position(island, y, (long)i);
+    double load = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i);
     double eta = b->damping;
     double lo = fmin(0.0, load / eta), hi = fmax(0.0, load / eta);
     double v = guess > lo && guess < hi ? guess : 0.5 * (lo + hi);
@@ -260,14 +258,14 @@ static double balance_velocity(const bk_island *island, double t, const double *
     return v;
 }
 
-/* v' of block i (without mass) from the balance's time derivative. */
-static double balance_acceleration(const bk_island *island, double t, const double *y, size_t i)
+/* v' of block i (without mass) from the balance's time derivative, given the balance's
+ * residual Phi = A - eta v - F(v, theta) at y (the right-hand side has it already). */
+static double balance_acceleration(const bk_island *island, const double *y, size_t i, double residual)
 {
     const bk_scene *scene = island->scene;
     const bk_block *b = &scene->model->blocks[i];
     const double *state = block_state(island, y, i);
-    double load, rate, d_rate, d_state;
-    spring_load(island, t, y, i, &load, &rate);
+    double d_rate, d_state;
     double v_i = y[scene->slot[i] + 1];
     friction_derivatives(scene, i, v_i, state, &d_rate, &d_state);
     double state_change = 0.0;
@@ -279,8 +277,8 @@ static double balance_acceleration(const bk_island *island, double t, const doub
     /* d Phi / dt = -Phi / balance_time: zero on the balance, so the exact solution is the
      * balance's, while the integrator's drift off it (which the derivative alone keeps and
      * accumulates between restarts) decays instead. */
-    double residual = load - b->damping * v_i - b->law->sliding_force(b->friction_params, scene->normal[i], v_i, state);
-    return (rate - state_change + residual / scene->balance_time) / (b->damping + d_rate);
+    return (spring_load_rate(island, y, i) - state_change + residual / scene->balance_time) /
+           (b->damping + d_rate);
 }
 
 void bk_island_restart(bk_island *island, double t, double *y)
@@ -459,8 +457,8 @@ static void rhs_parts(const bk_island *island, double t, const double *y, double
         ydot[s] = v_i;
         if (!(b->mass > 0.0)) {
             /* IDA: the balance itself; the ODE back-ends: its time derivative, stiff. */
-            double row = scene->full_layout ? applied + dashpots - dir * friction
-                                            : balance_acceleration(island, t, y, i);
+            double residual = applied + dashpots - dir * friction;
+            double row = scene->full_layout ? residual : balance_acceleration(island, y, i, residual);
             if (f_implicit) {
                 ydot[s + 1] = 0.0;
                 f_implicit[s + 1] = row;
@@ -690,12 +688,12 @@ double bk_island_slip_acceleration(const bk_island *island, size_t i, double t, 
     double driver_pos = bk_driver_segment_position(&scene->model->driver, island->driver_segment, t);
     double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
     double dir = (double)scene->mode[i];
-    if (!(b->mass > 0.0))
-        return dir * balance_acceleration(island, t, y, i);
     double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) +
                      damping_force(island, y, i);
     double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
                                             block_state(island, y, i));
+    if (!(b->mass > 0.0))
+        return dir * balance_acceleration(island, y, i, applied - dir * friction);
     return dir * (applied - dir * friction) / b->mass;
 }
 

@@ -2,7 +2,7 @@
  * and the variable-order BDF stepper msbdf (orders 1-5, Newton with GSL's dense LU on a
  * finite-difference Jacobian), with events located by bksim.
  *
- * Stepping: one gsl_odeiv2_evolve_apply per step() call (msbdf: msbdf_evolve, the same
+ * Stepping: one gsl_odeiv2_evolve_apply per step() call (msbdf: gsl_msbdf.c's evolve, the same
  * but for the derivative msbdf restarts from) with the scaled error control,
  * D_i = atol_i + rtol |y_i| (gsl_odeiv2_control_scaled_new with eps_abs = max atol and
  * scale_abs_i = atol_i / eps_abs; msbdf: gsl_shared.c's equivalent, whose errlevel, the
@@ -24,7 +24,7 @@
  *   gsl_msbdf: cubic Hermite on y and a derivative at both ends (third degree, local error
  *     O(h^4); msbdf keeps its Nordsieck history private, so its own interpolant is out of
  *     reach).  The derivative is f, but on stiff components that of the polynomial
- *     through the last step ends (history_derivative): there f magnifies the corrector's
+ *     through the last step ends (gsl_msbdf.c): there f magnifies the corrector's
  *     residual by |d f/d y| (rate-and-state slip rates came out a thousand times off).
  * That is for events and merges.  Output rows (sample) come from a Hermite polynomial
  * through this and older step ends (row_nodes.h), degree 11 / 7 / 5 for rk8pd / rkf45 /
@@ -57,69 +57,14 @@
 
 #include "bksim/solver.h"
 #include "capacity.h"
+#include "gsl_backend.h"
 #include "gsl_shared.h"
 #include "solver/row_nodes.h"
-
-typedef enum { DENSE_RESTEP, DENSE_HERMITE } dense_kind;
-
-typedef struct gsl_variant {
-    const char *label;
-    const gsl_odeiv2_step_type *const *type;
-    int order;              /* for the initial step estimate */
-    int needs_jacobian;
-    dense_kind dense;
-    double tolerance_factor; /* GSL's control gets rtol and atol times this */
-    size_t sample_nodes;     /* nodes of the output rows' Hermite polynomial (degree 2k - 1) */
-} gsl_variant;
 
 static const gsl_variant variant_rk8pd = {"rk8pd", &gsl_odeiv2_step_rk8pd, 8, 0, DENSE_RESTEP, 1.0, 6};
 static const gsl_variant variant_rkf45 = {"rkf45", &gsl_odeiv2_step_rkf45, 5, 0, DENSE_RESTEP, 1.0, 4};
 static const gsl_variant variant_msbdf = {"msbdf", &gsl_odeiv2_step_msbdf, 1, 1, DENSE_HERMITE, 0.1, 3};
 
-
-typedef struct gsl_backend {
-    const gsl_variant *variant;
-    bk_solver_options options;
-    bk_ode_problem problem;
-    double max_step;            /* INFINITY when unlimited */
-
-    gsl_odeiv2_system sys;
-    /* The objects a step uses.  msbdf carries history from step to step and reaches its
-     * control through a driver, so each instance owns one; the RK pairs carry nothing but
-     * evolve's dydt_out, which step() refills from f_lo, so they borrow shared ones. */
-    gsl_odeiv2_driver *driver;  /* msbdf: owns stepper, control and evolve */
-    bk_gsl_shared *shared;     /* RK: borrowed stepper (also the dense-output probe), evolve, control */
-    gsl_odeiv2_step *stepper;
-    gsl_odeiv2_evolve *evolve;
-    gsl_odeiv2_control *control;
-    size_t driver_n;            /* msbdf: the size the driver was made for */
-    gsl_root_fsolver *brent;    /* event location, made at the first event */
-    size_t n, capacity;         /* state size; allocated length of the arrays below */
-    double *arena;              /* every array below but active and found */
-    double *y_lo, *f_lo, *y_hi, *f_hi, *y_root, *y_probe, *atol, *work, *work2, *yerr,
-           *scale, /* the control's absolute weights: atol_i / eps_abs */
-           *y_back[2], /* msbdf: the two step ends before t_lo, newest first */
-           *stiffness; /* msbdf: |d f_i/d y_i| from the last Jacobian (0 before one) */
-    double eps_abs;
-    size_t root_capacity;
-    double *g_scan, *g_hi, *g_probe, *g_root;
-    int *active, *found;
-
-    double t_lo, t_hi;          /* the last step (t_lo == t_hi before the first) */
-    double t_back[2];           /* msbdf: times of y_back */
-    size_t n_back;              /* msbdf: how many of them this start has */
-    double t_stop, h;           /* h: next step size to try */
-    double t_scan;              /* roots before t_scan in the step are handled */
-    int stepped;                /* a step has been taken since the start */
-    int pending;                /* a root was returned inside the step: scan the rest */
-
-    bk_row_nodes rows;          /* output rows' polynomial (sample) */
-
-    bk_solver_counters count;   /* cumulative over starts */
-    int rhs_status;             /* last failing return value of the problem's rhs */
-    double rhs_fail_t;
-    int status;                 /* failure inside a GSL callback (dense output, roots) */
-} gsl_backend;
 
 /* --- callbacks ------------------------------------------------------------------------- */
 
@@ -567,7 +512,7 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
          * stiff component's Newton residual is not damped by the next step but comes back
          * whole in its correction, the error estimate: with the RMS test a residual on the
          * slip rate alone passed at sqrt(n) times what the error test allows, the next
-         * steps failed on it, msbdf reset itself and (see msbdf_evolve) could not restart.
+         * steps failed on it, msbdf reset itself and (see gsl_msbdf.c) could not restart.
          * Non-stiff components keep D_i (their residual is damped by h |d f/d y| < 1; at
          * 1/sqrt(n) for all, test_solver.c's oscillator took 30 % more steps). */
         gsl_odeiv2_control *own = b->driver ? bk_gsl_control_alloc() : NULL;
@@ -639,157 +584,6 @@ static int step_failed(gsl_backend *b, int status, double t, bk_error *err)
                    b->rhs_status > 0 ? "; the right-hand side kept failing" : "");
 }
 
-/* msbdf's derivative at t_hi, f_hi, for the dense output and for msbdf's restarts: per
- * component f(t_hi, y_hi) (f_exact), but for a stiff one (h |d f_i/d y_i| > 1, from the
- * last Jacobian) p', the derivative of the polynomial through the last step ends (t_lo,
- * t_hi and up to two before them, so cubic once the start has three steps).  A stiff
- * component sits on its slow manifold only to the corrector's tolerance, and f multiplies
- * that residual by the stiffness: with rate-and-state friction, d(v')/dv = -(d F/d v +
- * damping) / m reaches 1e14-1e17 1/s at slip rates of 1e-8 m/s for m <= 1e-3 kg, so
- * f(y_hi) in the velocity row is off by m/s^2 where v itself is 1e-8 m/s (the rows' slip
- * rates came out a thousand times off).  BDF methods keep no f of their own either (their
- * Nordsieck array is the polynomial through past solution values).  Elsewhere f is the
- * better: p' is O(h^3) and msbdf runs up to order 5, so on test_solver.c's oscillator p'
- * was a hundred tolerances off where f was exact.  Step sizes within a start grow by at
- * most GSL's factor 5, so the extrapolation to t_hi stays tame. */
-static void history_derivative(gsl_backend *b, const double *f_exact)
-{
-    double t[4];
-    const double *y[4];
-    size_t m = 0;
-    for (size_t k = b->n_back; k-- > 0;) { /* oldest first */
-        t[m] = b->t_back[k];
-        y[m++] = b->y_back[k];
-    }
-    t[m] = b->t_lo;
-    y[m++] = b->y_lo;
-    t[m] = b->t_hi;
-    y[m++] = b->y_hi;
-    size_t last = m - 1;
-    double w[4];
-    w[last] = 0.0;
-    for (size_t j = 0; j < last; ++j) {
-        w[last] += 1.0 / (t[last] - t[j]);
-        double c = 1.0 / (t[j] - t[last]);
-        for (size_t l = 0; l < last; ++l)
-            if (l != j)
-                c *= (t[last] - t[l]) / (t[j] - t[l]);
-        w[j] = c;
-    }
-    double h = b->t_hi - b->t_lo;
-    for (size_t i = 0; i < b->n; ++i) {
-        double d = 0.0;
-        for (size_t j = 0; j < m; ++j)
-            d += w[j] * y[j][i];
-        b->f_hi[i] = h * b->stiffness[i] > 1.0 ? d : f_exact[i];
-    }
-}
-
-/* Moves the stiff components (h |d f_i/d y_i| > 1 over the last step) of y at t back onto
- * their slow manifold, where f_i(t, y) equals the history's derivative f_lo_i: a few
- * Newton iterations on each, with its own difference quotient for d f_i/d y_i. */
-static int project_stiff(gsl_backend *b, double t, double *y)
-{
-    size_t n = b->n;
-    double h_last = b->t_lo - b->t_back[0];
-    if (b->n_back == 0 || !(h_last > 0.0))
-        return GSL_SUCCESS;
-    double *f = b->work, *f1 = b->work2, *yp = b->y_probe;
-    for (size_t i = 0; i < n; ++i) {
-        if (!(h_last * b->stiffness[i] > 1.0))
-            continue;
-        for (int iter = 0; iter < 4; ++iter) {
-            int rc = rhs_adapter(t, y, f, b);
-            if (rc != GSL_SUCCESS)
-                return rc;
-            memcpy(yp, y, n * sizeof *yp);
-            double inc = sqrt(DBL_EPSILON) * fmax(fabs(y[i]), b->atol[i] / b->options.rtol);
-            yp[i] = y[i] + inc;
-            inc = yp[i] - y[i];
-            if ((rc = rhs_adapter(t, yp, f1, b)) != GSL_SUCCESS)
-                return rc;
-            double d = (f1[i] - f[i]) / inc;
-            if (!(d != 0.0) || !isfinite(d))
-                break;
-            double delta = (f[i] - b->f_lo[i]) / d;
-            y[i] -= delta;
-            if (fabs(delta) <= 0.01 * (b->atol[i] + b->options.rtol * fabs(y[i])))
-                break;
-        }
-    }
-    return GSL_SUCCESS;
-}
-
-/* gsl_odeiv2_evolve_apply for msbdf (the same step-size logic: halve on a stepper failure,
- * retry at the control's smaller step on an error-test failure, stop when the step no
- * longer moves t), but the derivative handed to the stepper as dydt_in is f_lo, the
- * history's (history_derivative), not f(t, y) evaluated afresh.  msbdf uses dydt_in only
- * when it (re)initialises its Nordsieck array: at the start and after it resets itself,
- * at order 1, following four rejected attempts at one t.  With f(t, y) there, the order-1
- * predictor y + h f(t, y) overshoots a stiff component by h |d f/d y| times its residual,
- * which for the rate-and-state block exceeds the tolerance for every h down to the
- * rounding of t (1/|d f/d y| ~ 1e-15 s at t ~ 100 s has no double): every attempt failed
- * and the run stopped with "step size 2.55e-15 s".  After four failures in a row, at
- * order 1 (msbdf has reset itself), the stiff components of the step's start are moved
- * back onto their slow manifold first (project_stiff): a residual left there by an
- * earlier step, which a stale Jacobian let through, is otherwise corrected in full by
- * every attempt and counted as its error (seen at 3e-5 kg, rtol 1e-6 and 1e-12). */
-static int msbdf_evolve(gsl_backend *b, double *t, double t1, double *h)
-{
-    gsl_odeiv2_evolve *e = b->evolve;
-    size_t n = b->n;
-    double t0 = *t, h0 = *h, dt = t1 - t0;
-    double *y = b->y_hi;
-    memcpy(e->y0, y, n * sizeof *y);
-    int failures = 0, projected = 0;
-    for (;;) {
-        if (failures >= 4 && !projected && gsl_odeiv2_step_order(b->stepper) == 1) {
-            projected = 1;
-            int rc = project_stiff(b, t0, e->y0);
-            if (rc != GSL_SUCCESS)
-                return rc == GSL_FAILURE ? GSL_FAILURE : GSL_EBADFUNC;
-            memcpy(y, e->y0, n * sizeof *y);
-            memcpy(b->y_lo, e->y0, n * sizeof *y); /* the step's dense output starts there */
-        }
-        int final_step = h0 >= dt;
-        if (final_step)
-            h0 = dt;
-        int status = gsl_odeiv2_step_apply(b->stepper, t0, h0, y, e->yerr, b->f_lo, e->dydt_out, &b->sys);
-        if (status == GSL_EFAULT || status == GSL_EBADFUNC)
-            return status;
-        if (status != GSL_SUCCESS) {
-            double h_old = h0;
-            h0 *= 0.5;
-            if (fabs(h0) < fabs(h_old) && t0 + h0 != t0) {
-                memcpy(y, e->y0, n * sizeof *y);
-                e->failed_steps++;
-                failures++;
-                continue;
-            }
-            *h = h0;
-            return status;
-        }
-        double h_old = h0;
-        if (gsl_odeiv2_control_hadjust(b->control, b->stepper, y, e->yerr, e->dydt_out, &h0) ==
-            GSL_ODEIV_HADJ_DEC) {
-            if (fabs(h0) < fabs(h_old) && *t + h0 != *t) {
-                memcpy(y, e->y0, n * sizeof *y);
-                e->failed_steps++;
-                failures++;
-                continue;
-            }
-            *h = h0;
-            return GSL_FAILURE;
-        }
-        e->count++;
-        e->last_step = h_old;
-        *t = final_step ? t1 : t0 + h_old;
-        if (!final_step)
-            *h = h0;
-        return GSL_SUCCESS;
-    }
-}
-
 static int root_return(gsl_backend *b, double t_root, double *t_reached, double *y)
 {
     b->pending = 1;
@@ -820,7 +614,7 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
     /* One step from the end of the last. */
     if (b->t_hi > b->t_lo) {
         bk_row_nodes_push(&b->rows, b->t_lo, b->y_lo, b->f_lo);
-        if (b->driver) { /* msbdf: t_lo joins the step ends history_derivative reads */
+        if (b->driver) { /* msbdf: t_lo joins the step ends bk_gsl_history_derivative reads */
             double *oldest = b->y_back[1];
             b->y_back[1] = b->y_back[0];
             b->t_back[1] = b->t_back[0];
@@ -849,7 +643,7 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
     }
     unsigned long failed = e->failed_steps;
     b->rhs_status = 0;
-    int status = b->driver ? msbdf_evolve(b, &t, b->t_stop, &h_in)
+    int status = b->driver ? bk_gsl_msbdf_evolve(b, &t, b->t_stop, &h_in)
                            : gsl_odeiv2_evolve_apply(e, b->control, b->stepper, &b->sys, &t, b->t_stop, &h_in,
                                                      b->y_hi);
     b->count.err_test_fails += (long)(e->failed_steps - failed);
@@ -865,7 +659,7 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
     b->stepped = 1;
     b->count.steps++;
     if (b->driver) {
-        history_derivative(b, e->dydt_out);
+        bk_gsl_history_derivative(b, e->dydt_out);
     } else if (b->stepper->type->gives_exact_dydt_out) {
         memcpy(b->f_hi, e->dydt_out, n * sizeof *y);
     } else if (rhs_adapter(t, b->y_hi, b->f_hi, b) != GSL_SUCCESS) {

@@ -194,6 +194,19 @@ void write_small_with(const char *path, const bk_transition *transitions, size_t
     write_small_with_events(path, transitions, n, NULL, 0);
 }
 
+/* The three rows of the 3-block files below, at t = 0, 0.1, 0.2 s. */
+static void write_three_rows(const bk_sink *sink)
+{
+    bk_error err;
+    double x[3] = {0.1, 0.2, 0.3}, v[3] = {0}, fr[3] = {1, 2, 3}, cof[3] = {0.6, 0.6, 0.6};
+    int8_t mode[3] = {0, 1, -1};
+    for (int r = 0; r < 3; ++r) {
+        bk_sample sample = {.t = 0.1 * r, .driver = 0.7 * r, .n_blocks = 3, .x = x, .v = v,
+                            .friction = fr, .cof = cof, .mode = mode};
+        assert_int_equal(sink->sample(sink->self, &sample, &err), BK_OK);
+    }
+}
+
 void write_small_with_events(const char *path, const bk_transition *transitions, size_t n,
                              const bk_event *events, size_t n_events)
 {
@@ -204,13 +217,7 @@ void write_small_with_events(const char *path, const bk_transition *transitions,
     bk_error err;
     assert_int_equal(bk_h5_writer_open(&w, c, path, &err), BK_OK);
     bk_sink sink = bk_h5_writer_sink(w);
-    double x[3] = {0.1, 0.2, 0.3}, v[3] = {0}, fr[3] = {1, 2, 3}, cof[3] = {0.6, 0.6, 0.6};
-    int8_t mode[3] = {0, 1, -1};
-    for (int r = 0; r < 3; ++r) {
-        bk_sample sample = {.t = 0.1 * r, .driver = 0.7 * r, .n_blocks = 3, .x = x, .v = v,
-                            .friction = fr, .cof = cof, .mode = mode};
-        assert_int_equal(sink.sample(sink.self, &sample, &err), BK_OK);
-    }
+    write_three_rows(&sink);
     for (size_t k = 0; k < n; ++k)
         assert_int_equal(sink.transition(sink.self, &transitions[k], &err), BK_OK);
     for (size_t k = 0; k < n_events; ++k)
@@ -231,13 +238,7 @@ void write_small_with_rupture(const char *path, const bk_rupture *rupture, const
     bk_error err;
     assert_int_equal(bk_h5_writer_open(&w, c, path, &err), BK_OK);
     bk_sink sink = bk_h5_writer_sink(w);
-    double x[3] = {0.1, 0.2, 0.3}, v[3] = {0}, fr[3] = {1, 2, 3}, cof[3] = {0.6, 0.6, 0.6};
-    int8_t mode[3] = {0, 1, -1};
-    for (int r = 0; r < 3; ++r) {
-        bk_sample sample = {.t = 0.1 * r, .driver = 0.7 * r, .n_blocks = 3, .x = x, .v = v,
-                            .friction = fr, .cof = cof, .mode = mode};
-        assert_int_equal(sink.sample(sink.self, &sample, &err), BK_OK);
-    }
+    write_three_rows(&sink);
     assert_int_equal(sink.rupture(sink.self, rupture, blocks, n_blocks, rate, n_rate, &err), BK_OK);
     bk_run_stats stats = example_stats();
     assert_int_equal(bk_h5_writer_finish(w, &stats, &err), BK_OK);
