@@ -1,7 +1,7 @@
 # bksim: `make` builds libbksim.a and ./bksim; `make test` runs every cmocka program once on
 # the plain build.  CI (.ci/run) adds the AddressSanitizer + UndefinedBehaviorSanitizer build
-# (make test-asan), valgrind (make test-valgrind), make lint, make fuzz-replay and
-# make test-slurm.
+# (make test-asan), valgrind (make test-valgrind), the long statistical tests (make
+# test-long), make lint, make fuzz-replay and make test-slurm.
 
 CC       ?= gcc
 PKGS     := hdf5-serial gsl inih lapacke
@@ -29,7 +29,7 @@ TEST_SUPPORT := $(wildcard tests/support/*.c)
 objs = $(patsubst %.c,$(1)/%.o,$(2))
 
 .SECONDARY:
-.PHONY: all test test-plain test-asan test-valgrind test-slurm lint clean paper bench install fuzz fuzz-replay
+.PHONY: all test test-plain test-long test-asan test-valgrind test-slurm lint clean paper bench install fuzz fuzz-replay
 all: bksim
 
 build/libbksim.a: $(call objs,build,$(LIB_SRC))
@@ -61,6 +61,13 @@ build/tests/test_%: build/tests/test_%.o $(call objs,build,$(TEST_SUPPORT)) buil
 build-asan/tests/test_%: build-asan/tests/test_%.o $(call objs,build-asan,$(TEST_SUPPORT)) build-asan/libbksim.a
 	$(CC) $(CFLAGS) $(SAN) -o $@ $^ $(TEST_LIBS) $(LDLIBS)
 
+# Tests too long for make test (statistics of long runs), run by CI as make test-long.
+LONG_TESTS := $(patsubst tests/long/%.c,build/tests/long/%,$(wildcard tests/long/test_*.c))
+build/tests/long/test_%: build/tests/long/test_%.o $(call objs,build,$(TEST_SUPPORT)) build/libbksim.a
+	$(CC) $(CFLAGS) -o $@ $^ $(TEST_LIBS) $(LDLIBS)
+test-long: $(LONG_TESTS)
+	@scripts/run_tests.sh long $(LONG_TESTS)
+
 # Tests run from the repository root (they read configs/ and need ./bksim for CLI tests).
 test: test-plain
 test-plain: bksim build/bench/bksim_bench build/bench/h5_plain build/bench/exact_rows $(TESTS)
@@ -91,7 +98,7 @@ test-slurm: bksim
 # call each other, directly or round a circle: scripts/lint_calls.sh).
 lint: build/libbksim.a
 	cppcheck $$(cat tests/cppcheck.cfg) -Iinclude -Isrc -Itests/support src tests/*.c tests/support/*.c \
-	    tests/fuzz/*.c bench/*.c
+	    tests/long/*.c tests/fuzz/*.c bench/*.c
 	@bad=$$(nm -g --defined-only build/libbksim.a | awk 'NF == 3 && $$3 !~ /^bk_/ {print $$3}'); \
 	 if [ -n "$$bad" ]; then echo "lint: symbols of libbksim.a without the bk_ prefix:" $$bad >&2; exit 1; fi; \
 	 echo "lint: every exported symbol of libbksim.a starts with bk_"

@@ -4,9 +4,11 @@
 # (model.n_blocks = N, every block drawn its own x_init_random from the config's seed), run
 # as a user keeps only the catalog (output.interval = 0: rows at t = 0 and t_end only; the
 # rupture catalog on), each run one process timed by /usr/bin/time (CPU = user + sys, and
-# peak resident memory).  A rate-and-state block never sticks, so today the whole ring is
-# one island and a rupture's cost grows with N; the target is a method whose cost per
-# rupture stays within 3x that of N = 30 (the flat line on the plot).
+# peak resident memory).  A rate-and-state block never sticks, so the whole ring is one
+# island: integrated at once (method "whole", local_stepping = off) a rupture's cost grows
+# with N; cut into segments with their own integrators ("local", local_stepping = on, README
+# "Long chains") it should not.  The target: CPU per rupture at N = 10^4 within 3x that of
+# N = 30 (the flat line on the plot).
 # The chain starts at steady sliding and its first seconds are a transient (quiet, then a
 # burst of ruptures as the perturbations grow), so each N is run twice from the same start:
 # to t_skip and to t_end.  The window is [t_skip, t_end]: its CPU is the difference of the
@@ -25,7 +27,9 @@
 #   --quick            N = 30 100, R = 20, t_skip = 1 s, budget 60 s: a smoke run
 #   --plot-only        redraw the plot from OUTDIR/rs_chains.tsv, run nothing
 #   --method SPEC      a method to measure (repeatable; default $RS_METHODS, a list
-#                      separated by spaces, else cvode_bdf, the config's): a value of
+#                      separated by spaces, else the whole ring and the ring in segments,
+#                      cvode_bdf as the config has it: whole:solver.local_stepping=off
+#                      local:solver.local_stepping=on): a value of
 #                      solver.method, or LABEL:S.K=V[,S.K=V...] (the settings that select
 #                      it, the label naming its rows and curve)
 #   --sizes LIST       chain lengths, comma-separated (default 30,100,300,1000,3000,10000)
@@ -84,7 +88,7 @@ IFS=, read -r -a sizes <<< "${sizes_arg:-$sizes_default}"
 for n in "${sizes[@]}"; do bk_check_whole --sizes "$n" "chain lengths" 1; done
 mapfile -t sizes < <(printf '%s\n' "${sizes[@]}" | sort -n -u)
 if [ ${#specs[@]} -eq 0 ]; then
-    read -r -a specs <<< "${RS_METHODS:-cvode_bdf}"
+    read -r -a specs <<< "${RS_METHODS:-whole:solver.local_stepping=off local:solver.local_stepping=on}"
     [ ${#specs[@]} -gt 0 ] || bk_usage "RS_METHODS is set but names no method"
 fi
 # A method's label, and its settings as bksim run arguments (into method_sets).

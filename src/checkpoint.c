@@ -71,6 +71,9 @@ const bk_stat_field bk_run_stats_fields[] = {
     STAT_D(elastic_change, "J"), STAT_D(kinetic_change, "J"),
     STAT_D(energy_residual, "1"),
     {"damping_dissipation", 0, offsetof(bk_run_stats, damping_dissipation), "J", 1},
+    {"segments", 1, offsetof(bk_run_stats, segments), "1", 1},
+    {"coupling_error", 0, offsetof(bk_run_stats, coupling_error), "1", 1},
+    {"coupling_exceedances", 1, offsetof(bk_run_stats, coupling_exceedances), "1", 1},
 };
 const size_t bk_run_stats_n_fields = sizeof bk_run_stats_fields / sizeof bk_run_stats_fields[0];
 #undef STAT_L

@@ -570,6 +570,40 @@ static void check_imex(loader *ld, entry *method, const bk_model *m, double rtol
     }
 }
 
+/* local_stepping = on: a back-end that can move its stop time and publish its predictor,
+ * and a chain that stays one island (no block sticks, no spring goes slack), which the
+ * segments cut (run_segments.c). */
+static void check_local_stepping(loader *ld, const bk_config *c)
+{
+    entry *local = bk_config_lookup(ld, "solver", "local_stepping");
+    if (!local || strcmp(local->value, "on") != 0 || ld->error_rank != LONG_MAX)
+        return;
+    const bk_solver_backend *b = bk_solver_backend_find(c->solver.method);
+    if (strcmp(c->solver.method, "auto") != 0 && (!b || !b->set_stop || !b->predictor)) {
+        bk_config_report_entry(ld, local, "needs method cvode_bdf, cvode_adams or auto; method is %s",
+                               c->solver.method);
+        return;
+    }
+    if (c->prescribed || !c->model) {
+        bk_config_report_entry(ld, local, "applies to a chain or lattice of blocks, not a prescribed scene "
+                               "(allowed: auto, off)");
+        return;
+    }
+    const bk_model *m = c->model;
+    for (size_t i = 0; i < m->n_blocks; ++i)
+        if (m->blocks[i].law && (m->blocks[i].law->flags & BK_FRICTION_STATIC_THRESHOLD)) {
+            bk_config_report_entry(ld, local,
+                                   "needs laws without a stuck state on every block (such as rate-and-state); "
+                                   "block %zu uses law %s, whose stuck blocks already split the chain into "
+                                   "islands (allowed: auto, off)",
+                                   i, m->blocks[i].law->name);
+            return;
+        }
+    if (m->spring == BK_SPRING_TENSION_ONLY)
+        bk_config_report_entry(ld, local, "needs linear driver springs; [driver] spring = tension_only "
+                               "(allowed: auto, off)");
+}
+
 /* The method fits the scene and takes the options given: method = exact solves only
  * affine scenes, arkode_table needs a method with tables.  Said here, before any output. */
 static void check_method_fits(loader *ld, const bk_config *c)
@@ -678,7 +712,11 @@ bk_config *bk_config_build(loader *ld)
     s->min_step = value_of(ld, "solver", "min_step");
     snprintf(s->arkode_table, sizeof s->arkode_table, "%s",
              bk_solver_arkode_table((size_t)value_of(ld, "solver", "arkode_table")));
+    snprintf(s->local_stepping, sizeof s->local_stepping, "%s",
+             bk_config_local_stepping_names[(size_t)value_of(ld, "solver", "local_stepping")]);
+    s->segment_blocks = (long)value_of(ld, "solver", "segment_blocks");
     check_method_fits(ld, c);
+    check_local_stepping(ld, c);
     c->wall_time_limit = value_of(ld, "run", "wall_time_limit");
     c->seed = ld->seed;
 

@@ -18,6 +18,7 @@
 static const char *const boundary_names[] = {"free", "fixed", "periodic", NULL};
 static const char *const spring_names[] = {"linear", "tension_only", NULL};
 const char *const bk_config_linear_solver_names[] = {"auto", "dense", "band", NULL};
+const char *const bk_config_local_stepping_names[] = {"auto", "on", "off", NULL};
 
 /* "auto" (resolved by the run loop from the scene), then every registered back-end. */
 const char *bk_config_method_name(size_t i)
@@ -105,7 +106,7 @@ static const key_def keys[] = {
         "driver position at t = 0 (0: at the relaxed blocks)"),
 
     {"solver", {"method", "", 0, 0, 0, 0,
-                "integrator back-end; auto: exact for Coulomb scenes (open chains up to 1000 blocks, rings up to 100), else gsl_rk8pd, or cvode_bdf when stiff (README \"Solver back-ends\")"},
+                "integrator back-end; auto: exact for Coulomb scenes (open chains up to 1000 blocks, rings up to 100), cvode_bdf in segments for chains of 72 or more blocks that never stick (local_stepping), else gsl_rk8pd, or cvode_bdf when stiff (README \"Solver back-ends\")"},
      BK_KEY_CHOICE, NULL, bk_config_method_name, "auto"},
     {"solver", {"linear_solver", "", 0, 0, 0, 0, "linear solver of implicit methods: auto (band for long chains), dense, band"},
      BK_KEY_CHOICE, bk_config_linear_solver_names, NULL, "auto"},
@@ -127,6 +128,14 @@ static const key_def keys[] = {
                 "transitions closer than this count as one instant"}, BK_KEY_NUMBER, NULL, NULL,
      "1e-6 of the fastest natural period"},
 
+    {"solver", {"local_stepping", "", 0, 0, 0, 0,
+                "local time stepping: the chain cut into segments of segment_blocks blocks, each integrated at "
+                "its own pace and coupled through its edge blocks (README \"Local time stepping\"); auto: where "
+                "method = auto picks it (long chains whose blocks never stick); on: needs method cvode_bdf or "
+                "cvode_adams (or auto), every block's law without a stuck state, linear driver springs"},
+     BK_KEY_CHOICE, bk_config_local_stepping_names, NULL, "auto"},
+    INT("solver", "segment_blocks", 8, 2, INT_MAX, 0,
+        "blocks per segment under local time stepping (a lattice's segments are runs of its rows)"),
     NUM("solver", "min_step", "s", 0.0, 0.0, INFINITY, 0,
         "a step size below this stops the run with an error (0: no limit)"),
     {"solver", {"arkode_table", "", 0, 0, 0, 0,

@@ -29,6 +29,7 @@ typedef struct key_def {
 
 extern const char *const bk_config_sections[];           /* NULL-terminated, in reference order */
 extern const char *const bk_config_linear_solver_names[]; /* [solver] linear_solver words */
+extern const char *const bk_config_local_stepping_names[]; /* [solver] local_stepping words */
 const char *bk_config_method_name(size_t i);              /* [solver] method words; NULL past the end */
 const key_def *bk_config_find_key(const char *section, const char *key);
 const char *bk_config_enum_choice(const key_def *def, size_t i);

@@ -1,7 +1,9 @@
 /* An island's compact ODE, or IDA's full-layout DAE (layouts in scene.h): right-hand side,
  * root functions, Jacobian, and packing between the chain's arrays and the island's vector.
  * Everything here costs time in proportion to the island, never to the chain: blocks
- * outside the island are stuck, and only their positions enter (as fixed ends).
+ * outside the island are stuck, and only their positions enter (as fixed ends), or under
+ * local time stepping belong to a neighbouring segment, and enter as ghosts, their positions
+ * and velocities read off that segment's published tracks (scene.h, run_segments.c).
  *
  * Root functions, per block of the island (all clearly non-zero right after the block
  * switched, so a just-handled root cannot fire again after a restart):
@@ -40,6 +42,18 @@ size_t bk_island_y_length(const bk_scene *scene, const size_t *blocks, size_t le
 
 int bk_island_reserve(bk_island *island, size_t len)
 {
+    size_t room = len * island->scene->n_directions;
+    if (island->scene->segmented && room > island->ghost_capacity) {
+        size_t *ghosts = realloc(island->ghosts, room * sizeof *ghosts);
+        if (!ghosts)
+            return -1;
+        island->ghosts = ghosts;
+        size_t *edges = realloc(island->edges, room * sizeof *edges);
+        if (!edges)
+            return -1;
+        island->edges = edges;
+        island->ghost_capacity = room;
+    }
     if (bk_capacity_fits(len, island->capacity))
         return 0;
     size_t max_y = bk_island_max_y(island->scene, len);
@@ -63,6 +77,10 @@ int bk_island_reserve(bk_island *island, size_t len)
 
 void bk_island_free(bk_island *island)
 {
+    free(island->ghosts);
+    free(island->edges);
+    island->ghosts = island->edges = NULL;
+    island->n_ghosts = island->n_edges = island->ghost_capacity = 0;
     free(island->blocks); /* the block holding every layout array */
     island->blocks = island->active = island->stateful = NULL;
     island->active_mass = island->differential_id = NULL;
@@ -71,27 +89,70 @@ void bk_island_free(bk_island *island)
 }
 
 /* Position of block j given the island's vector: blocks integrated by this island from y,
- * every other block (stuck, so fixed) at x_ref. */
+ * every other block stuck, so fixed at x_ref, or (segmented) a ghost, as refresh_ghosts last
+ * evaluated it. */
 static inline double position(const bk_island *island, const double *y, long j)
 {
     if (j < 0)
         return 0.0; /* a fixed wall */
     const bk_scene *scene = island->scene;
     size_t s = scene->slot[j];
-    if (s == BK_NO_SLOT || scene->island_of[j] != island->id)
+    if (scene->island_of[j] != island->id)
+        return scene->segmented ? scene->ghost_x[j] : scene->x_ref[j];
+    if (s == BK_NO_SLOT)
         return scene->x_ref[j];
     return scene->x_ref[j] + y[s];
 }
 
+/* The ghosts' positions and velocities at t, before anything here reads them.  Every entry
+ * point that evaluates forces calls it: a neighbouring segment may have stepped since. */
+static void refresh_ghosts(const bk_island *island, double t)
+{
+    bk_scene *scene = island->scene;
+    for (size_t g = 0; g < island->n_ghosts; ++g) {
+        size_t j = island->ghosts[g];
+        bk_track_eval(&scene->tracks[scene->track_of[j]], t, &scene->ghost_x[j], &scene->ghost_v[j]);
+    }
+}
+
+/* A segment's ghosts and edge blocks (scene.h), from the partition as it stands (room
+ * reserved by bk_island_reserve). */
+static void find_ghosts(bk_island *island)
+{
+    bk_scene *scene = island->scene;
+    island->n_ghosts = island->n_edges = 0;
+    for (size_t k = 0; k < island->len; ++k) {
+        size_t i = bk_island_block(island, k);
+        const long *partner = bk_scene_partners(scene, i);
+        int edge = 0;
+        for (size_t d = 0; d < scene->n_directions; ++d) {
+            if (partner[d] < 0 || scene->island_of[partner[d]] == island->id)
+                continue;
+            edge = 1;
+            size_t j = (size_t)partner[d];
+            int seen = 0; /* a small ring's two sides can be one block */
+            for (size_t g = 0; g < island->n_ghosts && !seen; ++g)
+                seen = island->ghosts[g] == j;
+            if (!seen)
+                island->ghosts[island->n_ghosts++] = j;
+        }
+        if (edge)
+            island->edges[island->n_edges++] = i;
+    }
+}
+
 /* Driver-spring force with the spring's taut/slack state frozen since the restart. */
-/* Velocity of block j: this island's blocks from y, any other block (stuck) and a wall 0. */
+/* Velocity of block j: this island's blocks from y, a ghost as last evaluated, any other
+ * block (stuck) and a wall 0. */
 static inline double velocity(const bk_island *island, const double *y, long j)
 {
     if (j < 0)
         return 0.0;
     const bk_scene *scene = island->scene;
     size_t s = scene->slot[j];
-    if (s == BK_NO_SLOT || scene->island_of[j] != island->id)
+    if (scene->island_of[j] != island->id)
+        return scene->segmented ? scene->ghost_v[j] : 0.0;
+    if (s == BK_NO_SLOT)
         return 0.0;
     return y[s + 1];
 }
@@ -357,6 +418,10 @@ void bk_island_restart(bk_island *island, double t, double *y)
     island->n_y = next + scene->n_energy;
     island->half_bandwidth = half_bandwidth(island, 3 + max_state);
     island->t_ref = t;
+    if (scene->segmented) {
+        find_ghosts(island);
+        refresh_ghosts(island, t);
+    }
     /* Blocks without mass start on their force balance (the whole layout is in place now:
      * the balance reads the neighbours' positions). */
     for (size_t k = 0; k < island->n_active && island->n_massless > 0; ++k) {
@@ -442,6 +507,7 @@ static void rhs_parts(const bk_island *island, double t, const double *y, double
     double driver_force_sum = 0.0;
     double dissipation_rate = 0.0, damping_rate = 0.0;
     double *state_rates = f_implicit ? f_implicit : ydot;
+    refresh_ghosts(island, t);
     if (f_implicit)
         memset(f_implicit, 0, island->n_y * sizeof *f_implicit);
     for (size_t k = 0; k < island->n_active; ++k) {
@@ -625,7 +691,7 @@ static void jacobian_parts(const bk_island *island, const double *y, int frictio
 int bk_island_jacobian(double t, const double *y, void *user,
                        void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
 {
-    (void)t; /* the driver's segment is the island's: nothing here depends on the time */
+    refresh_ghosts(user, t); /* the dashpots' dissipation reads ghosts' velocities */
     jacobian_parts(user, y, 0, put, matrix);
     return 0;
 }
@@ -633,7 +699,7 @@ int bk_island_jacobian(double t, const double *y, void *user,
 int bk_island_jacobian_implicit(double t, const double *y, void *user,
                                 void (*put)(void *matrix, size_t row, size_t col, double value), void *matrix)
 {
-    (void)t;
+    refresh_ghosts(user, t);
     jacobian_parts(user, y, 1, put, matrix);
     return 0;
 }
@@ -645,6 +711,7 @@ int bk_island_roots(double t, const double *y, double *g, void *user)
     const bk_model *model = scene->model;
     size_t R = scene->roots_per_block;
     double driver_pos = bk_driver_segment_position(&model->driver, island->driver_segment, t);
+    refresh_ghosts(island, t);
     for (size_t k = 0; k < island->len; ++k) {
         size_t i = bk_island_block(island, k);
         const bk_block *b = &model->blocks[i];
@@ -688,6 +755,7 @@ double bk_island_slip_acceleration(const bk_island *island, size_t i, double t, 
     double driver_pos = bk_driver_segment_position(&scene->model->driver, island->driver_segment, t);
     double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
     double dir = (double)scene->mode[i];
+    refresh_ghosts(island, t);
     double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) +
                      damping_force(island, y, i);
     double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,

@@ -216,6 +216,7 @@ static void free_ctx(run_ctx *ctx)
     bk_run_ruptures_free(ctx);
     bk_run_catalog_free(ctx);
     bk_run_islands_free(ctx);
+    bk_run_segments_free(ctx);
     bk_run_partition_free(ctx);
     bk_scene_free(&ctx->scene);
     free(ctx->spring_energy_ref);
@@ -315,6 +316,7 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
     }
     if (method != config->solver.method)
         snprintf(ctx.stats->method, sizeof ctx.stats->method, "%s (auto)", method);
+    ctx.segment_blocks = bk_choose_segments(config, &ctx.scene, ctx.backend);
     size_t n = ctx.model->n_blocks;
     ctx.scene.full_layout = ctx.backend->wants_full_layout;
     ctx.spring_energy_ref = calloc(n, sizeof *ctx.spring_energy_ref);
@@ -330,6 +332,8 @@ int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sin
         rc = BK_FAIL(err, BK_ERR_NOMEM, "out of memory for %zu blocks", n);
         goto done;
     }
+    if ((rc = bk_run_segments_init(&ctx)) != BK_OK)
+        goto done;
     for (size_t i = 0; i < n; ++i)
         ctx.last_transition[i] = -INFINITY;
     if (ctx.event_rows) {

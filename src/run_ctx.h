@@ -154,6 +154,13 @@ typedef struct run_ctx {
     size_t rupture_saved_capacity;
     void *rupture_steps;     /* scratch: a step's slipping blocks */
     size_t rupture_steps_capacity;
+
+    /* Local time stepping (run_segments.c): blocks per segment (0: islands whole), each
+     * block's segment in the cut being made, and the tracks handed out. */
+    size_t segment_blocks;
+    size_t *segment_of;
+    size_t n_tracks, tracks_capacity;
+    int ghost_velocities;    /* ghosts' velocities enter the forces (checked as positions are) */
 } run_ctx;
 
 /* qsort's order of block indices (size_t). */
@@ -165,8 +172,8 @@ static inline int bk_compare_blocks(const void *a, const void *b)
 
 /* The run loop's files call one another downward only, in the order they are listed below:
  * run.c (set-up and the scheduler) on top, then restarts, island events, the partition, the
- * islands, quiet blocks, rows, transitions, the event catalog, the rupture catalog, the
- * energy books, probes and the clock.  A file calls only files listed after it, never one before: no circle of calls
+ * islands, segments, quiet blocks, rows, transitions, the event catalog, the rupture catalog,
+ * the energy books, probes and the clock.  A file calls only files listed after it, never one before: no circle of calls
  * (make lint checks it on the objects, scripts/lint_calls.sh). */
 
 /* ---- run_restart.c ---- */
@@ -221,6 +228,25 @@ int bk_run_unpack_island(run_ctx *ctx, run_island *isl, double t, int for_row, b
 int bk_run_unpack_all(run_ctx *ctx, double t);
 /* Counters of every back-end instance so far. */
 void bk_run_solver_counters(const run_ctx *ctx, bk_solver_counters *total);
+/* Destroy the idle back-end instances (their counters kept).  A restarted instance need not
+ * step as a new one does (CVODE's does not, to the last bit), so at a restart of everything
+ * the islands start on new instances, as in a run resumed there. */
+void bk_run_drain_pool(run_ctx *ctx);
+
+/* ---- run_segments.c ---- */
+/* Tracks and scratch when ctx->segment_blocks is set (the scene becomes segmented). */
+int bk_run_segments_init(run_ctx *ctx);
+void bk_run_segments_free(run_ctx *ctx);
+/* A component (members, in the island's order) about to be founded as `pieces` segments of
+ * consecutive members: its edge blocks get tracks, set from the chain's arrays at t. */
+int bk_run_segments_prepare(run_ctx *ctx, const size_t *members, size_t count, size_t pieces, double t);
+/* A segment (re)started: its edge blocks' tracks from its start. */
+int bk_run_segment_started(run_ctx *ctx, run_island *isl);
+/* Before a segment's step: it may go only as far as its ghosts' tracks are trusted. */
+int bk_run_segment_stop(run_ctx *ctx, run_island *isl);
+/* After a segment's step: its edge blocks' tracks from its integrator, and the coupling
+ * error of the tracks they replace. */
+int bk_run_segment_stepped(run_ctx *ctx, run_island *isl);
 
 /* ---- run_quiet.c ---- */
 /* Block i (stuck, next to no slipping block) leaves the integrators at t; its breakaway

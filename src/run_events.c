@@ -127,20 +127,26 @@ int bk_run_island_step(run_ctx *ctx, size_t id)
 {
     run_island *isl = ctx->islands[id];
     double t_reached;
+    int segmented = ctx->scene.segmented;
+    int rc = segmented ? bk_run_segment_stop(ctx, isl) : BK_OK;
+    if (rc != BK_OK)
+        return rc;
     int step = ctx->backend->step(isl->solver, &t_reached, isl->y, ctx->err);
     if (step < 0)
         return step;
     isl->stepped = 1;
     isl->t_reached = t_reached;
     ctx->restart_work += (double)isl->island.len;
-    int rc = check_finite(ctx, isl, t_reached);
-    if (rc != BK_OK)
+    if ((rc = check_finite(ctx, isl, t_reached)) != BK_OK ||
+        (segmented && (rc = bk_run_segment_stepped(ctx, isl)) != BK_OK))
         return rc;
-    if (++ctx->steps_since_row > ctx->options.max_steps)
+    /* The hang guard counts steps of the whole chain: segments share it. */
+    long allowed = ctx->options.max_steps * (segmented ? (long)ctx->live_islands : 1);
+    if (++ctx->steps_since_row > allowed)
         return BK_FAIL(ctx->err, BK_ERR_MAX_STEPS,
                        "more than %ld solver steps since the last output row or transition "
                        "(t = %.17g s, now at t = %.17g s); raise [solver] max_steps or loosen rtol",
-                       ctx->options.max_steps, ctx->t_last_row, t_reached);
+                       allowed, ctx->t_last_row, t_reached);
     if (step == BK_STEP_ROOT) {
         rc = find_event(ctx, isl, t_reached, 1);
     } else {

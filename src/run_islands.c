@@ -147,6 +147,18 @@ static void give_back_solver(run_ctx *ctx, run_island *isl)
     ctx->backend->destroy(solver);
 }
 
+void bk_run_drain_pool(run_ctx *ctx)
+{
+    for (size_t k = 0; k < ctx->n_idle; ++k) {
+        bk_solver_counters c;
+        ctx->backend->counters(ctx->idle[k], &c);
+        bk_solver_counters_add(&ctx->retired, &c);
+        ctx->backend->destroy(ctx->idle[k]);
+    }
+    ctx->n_idle = 0;
+    ctx->idle_held = 0;
+}
+
 /* A free island id with its arrays (kept from an earlier island when there is one). */
 static int new_island(run_ctx *ctx, size_t n_y, size_t *id)
 {
@@ -273,6 +285,8 @@ int bk_run_start_island(run_ctx *ctx, size_t id, double t)
     isl->pending = 0;
     isl->t_reached = t;
     isl->t_resume = t;
+    if (ctx->scene.segmented && (rc = bk_run_segment_started(ctx, isl)) != BK_OK)
+        return rc;
     bk_run_catalog_island_start(ctx, isl);
     if ((rc = bk_run_ruptures_island_start(ctx, isl)) != BK_OK)
         return rc;

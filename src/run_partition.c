@@ -134,6 +134,22 @@ static void order_members(run_ctx *ctx, size_t count)
     }
 }
 
+/* The component in ctx->members as one island, or under local time stepping as segments of
+ * about segment_blocks consecutive blocks of its order (a lattice's: runs of its rows). */
+static int found_segments(run_ctx *ctx, size_t count, double t)
+{
+    size_t size = ctx->segment_blocks;
+    if (size == 0 || count <= size)
+        return bk_run_found_island(ctx, ctx->members, count, t);
+    size_t pieces = (count + size - 1) / size;
+    int rc = bk_run_segments_prepare(ctx, ctx->members, count, pieces, t);
+    for (size_t p = 0; p < pieces && rc == BK_OK; ++p) {
+        size_t first = p * count / pieces, last = (p + 1) * count / pieces;
+        rc = bk_run_found_island(ctx, ctx->members + first, last - first, t);
+    }
+    return rc;
+}
+
 /* Islands and quiet blocks over the region (no block of it in an island; see the top). */
 static int rebuild(run_ctx *ctx, double t)
 {
@@ -166,7 +182,7 @@ static int rebuild(run_ctx *ctx, double t)
             }
         }
         order_members(ctx, count);
-        int rc = bk_run_found_island(ctx, ctx->members, count, t);
+        int rc = found_segments(ctx, count, t);
         if (rc != BK_OK)
             return rc;
     }
@@ -202,6 +218,11 @@ int bk_run_repartition(run_ctx *ctx, const size_t *seeds, size_t n_seeds, double
     return rebuild(ctx, t);
 }
 
+static int descending(const void *a, const void *b)
+{
+    return bk_compare_blocks(b, a);
+}
+
 int bk_run_partition_all(run_ctx *ctx, double t)
 {
     for (size_t id = 0; id < ctx->islands_used; ++id)
@@ -211,6 +232,11 @@ int bk_run_partition_all(run_ctx *ctx, double t)
                 return rc;
         }
     bk_heap_clear(&ctx->quiet);
+    bk_run_drain_pool(ctx);
+    /* Ids handed out smallest first, as in a run that starts here: the scheduler breaks ties
+     * between islands by id, and segments at one time are not independent of the order in
+     * which they step, so a resumed run must number them as the uninterrupted one. */
+    qsort(ctx->free_ids, ctx->n_free, sizeof *ctx->free_ids, descending);
     ctx->n_region = 0;
     for (size_t i = 0; i < ctx->scene.n; ++i)
         region_add(ctx, i);

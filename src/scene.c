@@ -83,6 +83,10 @@ void bk_scene_free(bk_scene *scene)
     free(scene->state_slot);
     free(scene->island_of);
     free(scene->partner);
+    free(scene->track_of);
+    free(scene->tracks);
+    free(scene->ghost_x);
+    free(scene->ghost_v);
     memset(scene, 0, sizeof *scene);
 }
 

@@ -30,6 +30,7 @@
 
 #include "bksim/model.h"
 #include "bksim/modes.h"
+#include "bksim/solver.h"
 
 /* Root slots per block: 0 = breakaway (stuck) or stop (slipping), 1 = slip-rate minimum,
  * 2 = driver spring going slack/taut (tension-only springs only). */
@@ -80,7 +81,46 @@ typedef struct bk_scene {
     double slip_threshold;   /* m/s: the event catalog's slip rate for laws without a stuck
                                 state (0: none; then their roots stay silent) */
     uint8_t *above;          /* per block of such a law: |v| above slip_threshold (NULL: none) */
+    /* Local time stepping (run_segments.c): the chain is cut into segments, islands each with
+     * its own integrator and time, coupled through their edge blocks.  A partner in another
+     * segment is a ghost: its position and velocity at the time of an evaluation come from
+     * the track its segment publishes (below), and go into ghost_x, ghost_v. */
+    int segmented;
+    size_t *track_of;        /* per block: its track, or BK_NO_TRACK (not next to another segment) */
+    struct bk_track *tracks;
+    double *ghost_x, *ghost_v; /* m, m/s: per block, as last evaluated for a neighbouring segment */
 } bk_scene;
+
+#define BK_NO_TRACK SIZE_MAX
+
+/* What a segment publishes about one of its edge blocks after each step: the integrator's
+ * own polynomial (its predictor, which is also its dense output over the last step) for the
+ * block's slip and velocity, about the step's end t_n, and how far ahead it can be trusted. */
+typedef struct bk_track {
+    double t_n;              /* s */
+    double x0;               /* m: the block's position at its segment's restart (x = x0 + slip) */
+    double limit;            /* s: extrapolation is trusted up to here */
+    double safety;           /* lookahead factor, halved after each coupling error measured over 1 */
+    int order;
+    double slip[BK_PREDICTOR_MAX_ORDER + 1];     /* m / s^k: Taylor coefficients about t_n */
+    double velocity[BK_PREDICTOR_MAX_ORDER + 1]; /* m/s / s^k */
+} bk_track;
+
+static inline double bk_track_horner(const double *coef, int order, double s)
+{
+    double value = coef[order];
+    for (int k = order - 1; k >= 0; --k)
+        value = value * s + coef[k];
+    return value;
+}
+
+/* Position and velocity of a track's block at t. */
+static inline void bk_track_eval(const bk_track *track, double t, double *x, double *v)
+{
+    double s = t - track->t_n;
+    *x = track->x0 + bk_track_horner(track->slip, track->order, s);
+    *v = bk_track_horner(track->velocity, track->order, s);
+}
 
 int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema);
 void bk_scene_free(bk_scene *scene);
@@ -162,6 +202,11 @@ typedef struct bk_island {
     int affine;              /* the compact ODE is affine in y and t (see bk_ode_problem) */
     size_t n_massless;       /* active blocks without mass (quasi-dynamic; island.c) */
     size_t capacity;         /* blocks the arrays above have room for */
+    /* A segment's (scene->segmented) partners in other segments, and its own blocks next to
+     * them, found at every restart. */
+    size_t *ghosts, n_ghosts;
+    size_t *edges, n_edges;
+    size_t ghost_capacity;   /* room in each of the two */
 } bk_island;
 
 static inline size_t bk_island_block(const bk_island *island, size_t k)

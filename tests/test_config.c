@@ -437,6 +437,50 @@ static const char quasi_dynamic_config[] = "[model]\n"
                                            "[run]\n"
                                            "t_end = 1\n";
 
+/* [solver] local_stepping = on needs a back-end with a predictor and a chain that stays one
+ * island; each refusal names the key, what is wrong and what is allowed. */
+static void test_local_stepping(void **state)
+{
+    (void)state;
+    bk_config *c = NULL;
+    bk_error err = {0};
+    const char *on[] = {"solver.local_stepping=on", "solver.method=cvode_bdf", "solver.segment_blocks=2"};
+    assert_int_equal(bk_config_load_string(quasi_dynamic_config, "q.ini", on, 3, &c, &err), BK_OK);
+    assert_string_equal(c->solver.local_stepping, "on");
+    assert_int_equal(c->solver.segment_blocks, 2);
+    bk_config_free(c);
+    static const struct {
+        const char *set[3];
+        const char *message;
+    } cases[] = {
+        {{"solver.local_stepping=on", "solver.method=gsl_rk8pd", NULL},
+         "[solver] local_stepping: needs method cvode_bdf, cvode_adams or auto; method is gsl_rk8pd"},
+        {{"solver.local_stepping=on", "driver.spring=tension_only", NULL},
+         "[solver] local_stepping: needs linear driver springs"},
+        {{"solver.local_stepping=yes", NULL, NULL}, "[solver] local_stepping"},
+        {{"solver.segment_blocks=1", NULL, NULL}, "[solver] segment_blocks"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        size_t n = cases[k].set[1] ? 2 : 1;
+        c = (bk_config *)&c;
+        int rc = bk_config_load_string(quasi_dynamic_config, "q.ini", cases[k].set, n, &c, &err);
+        if (rc != BK_ERR_CONFIG || !strstr(err.message, cases[k].message))
+            print_error("case %zu: rc %d\n got:      %s\n expected: %s\n", k, rc, err.message, cases[k].message);
+        assert_int_equal(rc, BK_ERR_CONFIG);
+        assert_null(c);
+    }
+    /* A law that sticks: its stuck blocks split the chain already. */
+    const char *text = "[model]\nn_blocks = 3\ncoupling_stiffness = 1\n[block]\nmass = 1\ndriver_stiffness = 1\n"
+                       "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n[driver]\nvelocity = 1e-3\n"
+                       "[solver]\nmethod = cvode_bdf\nlocal_stepping = on\n[run]\nt_end = 1\n";
+    c = (bk_config *)&c;
+    int rc = bk_config_load_string(text, "c.ini", NULL, 0, &c, &err);
+    assert_int_equal(rc, BK_ERR_CONFIG);
+    assert_null(c);
+    assert_non_null(strstr(err.message, "c.ini:15: [solver] local_stepping: needs laws without a stuck state on "
+                                        "every block (such as rate-and-state); block 0 uses law coulomb"));
+}
+
 static void test_quasi_dynamic(void **state)
 {
     (void)state;
@@ -926,6 +970,7 @@ int main(void)
         cmocka_unit_test(test_tolerated_forms),
         cmocka_unit_test(test_rejections),
         cmocka_unit_test(test_quasi_dynamic),
+        cmocka_unit_test(test_local_stepping),
         cmocka_unit_test(test_first_error_reported),
         cmocka_unit_test(test_out_of_range_draw_stays_the_error),
         cmocka_unit_test(test_overrides),

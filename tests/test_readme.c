@@ -151,6 +151,7 @@ static void test_layout_names_every_file(void **state)
     list_tree("scripts/", 1, &found);
     list_tree("tests/", 0, &found);
     list_tree("tests/support/", 0, &found);
+    list_tree("tests/long/", 0, &found);
     list_tree("tests/fuzz/", 0, &found);
     list_tree("bench/", 0, &found);
     list_tree(".ci/", 0, &found);

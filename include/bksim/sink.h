@@ -97,6 +97,10 @@ typedef struct bk_run_stats {
     double elastic_change;    /* J, elastic energy at t_reached minus at 0 */
     double kinetic_change;    /* J */
     double energy_residual;   /* (W - dE_el - dE_kin - D - D_damping) / the largest term, dimensionless */
+    long segments;            /* local time stepping: segments the chain is cut into (0: none) */
+    double coupling_error;    /* local time stepping: the largest error of a ghost's extrapolation
+                                 measured, over the integrator's tolerance (dimensionless) */
+    long coupling_exceedances; /* such errors above 1 */
 } bk_run_stats;
 
 /* What a progress callback is told: how far the run is, and what it has produced. */

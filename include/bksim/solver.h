@@ -28,6 +28,8 @@ typedef struct bk_solver_options {
     double min_step;        /* s: a step below this is an error; 0 = no limit (default) */
     char arkode_table[48];  /* ARKODE Butcher table of arkode_erk / arkode_dirk; "default":
                                the method's own (Zonneveld 5_3_4, ESDIRK43I6L2SA 6_3_4) */
+    char local_stepping[8]; /* "auto" | "on" | "off": segments with their own integrators */
+    long segment_blocks;    /* blocks per segment; default 32 */
 } bk_solver_options;
 
 typedef struct bk_ode_problem {
@@ -114,7 +116,23 @@ typedef struct bk_solver_backend {
     /* Options only some back-ends take ([solver] arkode_table): 0 if these are fine, else
      * -1 with the reason in message.  NULL: the back-end takes none. */
     int (*check_options)(const bk_solver_options *options, char *message, size_t len);
+    /* Local time stepping ([solver] local_stepping) needs the next two; NULL: the back-end
+     * cannot serve it.  set_stop moves the stop time t_stop given at start (to any time not
+     * before the last step's end). */
+    int (*set_stop)(void *mem, double t_stop, bk_error *err);
+    /* The polynomial the back-end extrapolates its solution by into the next step (its
+     * predictor), which is also its dense output over the last step, for `count` components:
+     * about t_n, the last step's end, coef[j * (BK_PREDICTOR_MAX_ORDER + 1) + k] =
+     * y_c^(k)(t_n) / k! for component c = components[j] and k = 0 .. *order; error_ratio[j]
+     * the last step's local error estimate of component c over its tolerance (the error
+     * test passes when their root mean square over all components is at most 1); *h_last
+     * the last step's size and *h_next the one the back-end means to try next. */
+    int (*predictor)(void *mem, const size_t *components, size_t count, double *t_n, double *h_last,
+                     double *h_next, int *order, double *coef, double *error_ratio, bk_error *err);
 } bk_solver_backend;
+
+/* The highest order a back-end's predictor polynomial can have (CVODE's Adams method). */
+#define BK_PREDICTOR_MAX_ORDER 12
 
 const bk_solver_backend *bk_solver_backend_find(const char *name);
 /* Names [solver] arkode_table accepts, i = 0, 1, ... (NULL past the end): "default" first,

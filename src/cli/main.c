@@ -459,6 +459,10 @@ static int cmd_run(int argc, char **argv)
                "energy residual %.2g, %.3f s CPU\n",
                path, stats.rows, stats.transitions, stats.t_reached, stats.steps, stats.rhs_evals,
                stats.energy_residual, stats.cpu_time);
+        if (stats.segments > 0)
+            printf("%s: local time stepping in %ld segments; largest coupling error %.3g of the "
+                   "tolerance (%ld above it)\n",
+                   path, stats.segments, stats.coupling_error, stats.coupling_exceedances);
     }
     bk_config_free(config);
     free(args.overrides);

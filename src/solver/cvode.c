@@ -212,6 +212,66 @@ static int interpolate(void *mem, double t, double *y, bk_error *err)
     return BK_OK;
 }
 
+static int set_stop(void *mem, double t_stop, bk_error *err)
+{
+    cvode_backend *cv = mem;
+    int flag = CVodeSetStopTime(cv->cvode, t_stop);
+    if (flag != CV_SUCCESS)
+        return fail(cv, err, "CVodeSetStopTime", flag);
+    cv->base.t_stop = t_stop;
+    return BK_OK;
+}
+
+/* CVODE's history is a Nordsieck array: derivatives at t_n scaled by powers of the step, the
+ * predictor of the next step and the dense output of the last one both being its Taylor
+ * polynomial, which CVodeGetDky(t_n, k) reads term by term. */
+static int predictor(void *mem, const size_t *components, size_t count, double *t_n, double *h_last,
+                     double *h_next, int *order, double *coef, double *error_ratio, bk_error *err)
+{
+    cvode_backend *cv = mem;
+    bk_sundials_base *base = &cv->base;
+    sunrealtype tn = 0.0, h = 0.0, next = 0.0;
+    int q = 0;
+    CVodeGetCurrentTime(cv->cvode, &tn);
+    CVodeGetLastStep(cv->cvode, &h);
+    CVodeGetCurrentStep(cv->cvode, &next);
+    CVodeGetLastOrder(cv->cvode, &q);
+    long steps = 0;
+    CVodeGetNumSteps(cv->cvode, &steps);
+    if (steps == 0)
+        q = 0; /* nothing but the start: its value only */
+    const double *work = N_VGetArrayPointer(base->work);
+    double factorial = 1.0;
+    for (int k = 0; k <= q; ++k) {
+        if (k > 0)
+            factorial *= k;
+        int flag = CVodeGetDky(cv->cvode, tn, k, base->work);
+        if (flag != CV_SUCCESS)
+            return fail(cv, err, "CVodeGetDky", flag);
+        for (size_t j = 0; j < count; ++j)
+            coef[j * (BK_PREDICTOR_MAX_ORDER + 1) + (size_t)k] = work[components[j]] / factorial;
+    }
+    if (steps == 0) {
+        for (size_t j = 0; j < count; ++j)
+            error_ratio[j] = 0.0;
+    } else {
+        int flag = CVodeGetEstLocalErrors(cv->cvode, base->work);
+        if (flag != CV_SUCCESS)
+            return fail(cv, err, "CVodeGetEstLocalErrors", flag);
+        for (size_t j = 0; j < count; ++j)
+            error_ratio[j] = fabs(work[components[j]]);
+        if ((flag = CVodeGetErrWeights(cv->cvode, base->work)) != CV_SUCCESS)
+            return fail(cv, err, "CVodeGetErrWeights", flag);
+        for (size_t j = 0; j < count; ++j)
+            error_ratio[j] *= work[components[j]];
+    }
+    *t_n = tn;
+    *h_last = steps == 0 ? 0.0 : h;
+    *h_next = steps == 0 ? 0.0 : next;
+    *order = q;
+    return BK_OK;
+}
+
 static void last_step(void *mem, double *t_lo, double *t_hi)
 {
     cvode_backend *cv = mem;
@@ -254,6 +314,8 @@ const bk_solver_backend bk_solver_cvode_adams = {
     .root_info = root_info,
     .counters = counters,
     .destroy = destroy,
+    .set_stop = set_stop,
+    .predictor = predictor,
 };
 
 const bk_solver_backend bk_solver_cvode_bdf = {
@@ -267,4 +329,6 @@ const bk_solver_backend bk_solver_cvode_bdf = {
     .root_info = root_info,
     .counters = counters,
     .destroy = destroy,
+    .set_stop = set_stop,
+    .predictor = predictor,
 };
