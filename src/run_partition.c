@@ -236,7 +236,8 @@ int bk_run_partition_all(run_ctx *ctx, double t)
     /* Ids handed out smallest first, as in a run that starts here: the scheduler breaks ties
      * between islands by id, and segments at one time are not independent of the order in
      * which they step, so a resumed run must number them as the uninterrupted one. */
-    qsort(ctx->free_ids, ctx->n_free, sizeof *ctx->free_ids, descending);
+    if (ctx->n_free > 1)
+        qsort(ctx->free_ids, ctx->n_free, sizeof *ctx->free_ids, descending);
     ctx->n_region = 0;
     for (size_t i = 0; i < ctx->scene.n; ++i)
         region_add(ctx, i);

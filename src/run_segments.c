@@ -1,8 +1,9 @@
 /* Local time stepping: a chain whose blocks never stick is one island, and integrating it
  * whole makes every block take the steps of the fastest rupture anywhere, so a step costs
  * the chain and a rupture costs the chain times its steps.  Here the island is cut into
- * segments of a few tens of blocks (run_partition.c cuts; scene.h), each with its own
- * integrator and its own time, and a rupture costs the segments it runs through.
+ * segments of [solver] segment_blocks blocks (default 8; run_partition.c cuts; scene.h),
+ * each with its own integrator and its own time, and a rupture costs the segments it runs
+ * through.
  *
  * Coupling.  A segment sees a partner in another segment (a ghost) through the track that
  * segment publishes after each of its steps: the integrator's own polynomial for the block's
