@@ -170,21 +170,30 @@ int bk_b_value(const double *m, size_t n, double mc, double dm, bk_b_estimate *o
             sum += (double)(k - k_mc);
         }
     }
-    if (count < 2)
+    if (count < BK_B_MIN_EVENTS)
         return BK_FAIL(err, BK_ERR_INVALID,
                        "%zu magnitude%s at or above Mc = %g (bins of dm = %g): the b-value "
-                       "needs at least 2",
-                       count, count == 1 ? "" : "s", (double)k_mc * dm, dm);
+                       "needs at least %d",
+                       count, count == 1 ? "" : "s", (double)k_mc * dm, dm, BK_B_MIN_EVENTS);
     double mean_offset = sum / (double)count;
     double squares = 0.0;
+    long k_max = k_mc;
     for (size_t i = 0; i < n; ++i) {
         long k = 0;
         bk_mag_bin(m[i], dm, &k, NULL);
         if (k >= k_mc) {
             double d = (double)(k - k_mc) - mean_offset;
             squares += d * d;
+            if (k > k_max)
+                k_max = k;
         }
     }
+    if (k_max == k_mc)
+        return BK_FAIL(err, BK_ERR_INVALID,
+                       "all %zu magnitudes at or above Mc = %g fall in one bin of dm = %g: no spread "
+                       "to estimate a slope from (a narrower --bin, or a catalog with a range of "
+                       "magnitudes)",
+                       count, (double)k_mc * dm, dm);
     out->mc = (double)k_mc * dm;
     out->dm = dm;
     out->n = count;

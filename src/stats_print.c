@@ -71,13 +71,29 @@ int bk_stats_report_text(const bk_stats_report *r, FILE *out, bk_error *err)
         fprintf(out, "  events at or above Mc: %zu (rate %.6g events/s)\n", r->n_above_mc,
                 r->rate_above_mc);
     }
-    if (r->have_b)
+    if (r->have_b) {
         fprintf(out,
                 "b-value: %.4f +- %.4f (Aki-Utsu maximum likelihood, Shi & Bolt error; Aki's "
                 "b/sqrt(n) = %.4f), a = %.4f, over %zu events, mean magnitude %.4f\n",
                 r->b.b, r->b.sigma, r->b.sigma_aki, r->b.a, r->b.n, r->b.mean);
-    else
+        if (r->b_small_sample)
+            fprintf(out, "  warning: small sample, %zu events at or above Mc (< %d): b is uncertain to "
+                         "about 1/sqrt(n) = %.0f %%\n",
+                    r->b.n, BK_B_SMALL_SAMPLE, 100.0 / sqrt((double)r->b.n));
+        if (r->have_b_spread)
+            fprintf(out, "  bootstrap (%zu resamples of the catalog, Mc %s): b +- %.4f, Mc +- %.4f\n",
+                    r->b_spread.n_used, o->mc_auto ? "re-estimated" : "given", r->b_spread.b_sigma,
+                    r->b_spread.mc_sigma);
+    } else {
         fprintf(out, "b-value: not available: %s\n", r->b_note);
+    }
+    if (!r->have_gr_gof && r->have_b)
+        fprintf(out, "  fit: not tested (--bootstrap 0)\n");
+    if (r->have_gr_gof)
+        fprintf(out, "  fit: %s Gutenberg-Richter above Mc: KS distance %.4f, bootstrap p = %.3g (%zu "
+                     "synthetic samples, refitted)\n",
+                r->gr_gof.p < BK_GOF_LEVEL ? "not" : "consistent with", r->gr_gof.d, r->gr_gof.p,
+                r->gr_gof.n_synthetic);
     if (r->have_potency_exponent) {
         const bk_power_law *p = &r->potency_fit;
         fprintf(out, "potency exponent: alpha = %.4f +- %.4f over %zu events with P >= %.6g m "
@@ -92,6 +108,11 @@ int bk_stats_report_text(const bk_stats_report *r, FILE *out, bk_error *err)
     } else {
         fprintf(out, "potency exponent: not available: %s\n", r->potency_note);
     }
+    if (r->have_potency_gof)
+        fprintf(out, "  fit: %s a power law above P_min: KS distance %.4f, bootstrap p = %.3g (%zu "
+                     "synthetic samples, refitted)\n",
+                r->potency_gof.p < BK_GOF_LEVEL ? "not" : "consistent with", r->potency_gof.d, r->potency_gof.p,
+                r->potency_gof.n_synthetic);
     if (r->have_recurrence)
         fprintf(out, "recurrence (M >= Mc): %zu events, mean interval %.6g s, sd %.6g s, "
                      "CV %.4f (1 for a Poisson process)\n",
@@ -164,6 +185,22 @@ static void json_note(FILE *out, const char *key, int have, const char *note)
     fprintf(out, ", ");
 }
 
+/* "key": {"n": .., "ks_distance": .., "p_value": .., "synthetic_samples": .., "consistent": ..}
+ * or null when the fit was not tested. */
+static void json_gof(FILE *out, const char *key, int have, const bk_gof *g)
+{
+    fprintf(out, "\"%s\": ", key);
+    if (!have) {
+        fprintf(out, "null, ");
+        return;
+    }
+    fprintf(out, "{\"n\": %zu, ", g->n);
+    json_number(out, "ks_distance", g->d, 0);
+    json_number(out, "p_value", g->p, 0);
+    fprintf(out, "\"synthetic_samples\": %zu, \"consistent\": %s}, ", g->n_synthetic,
+            g->p < BK_GOF_LEVEL ? "false" : "true");
+}
+
 int bk_stats_report_json(const bk_stats_report *r, FILE *out, bk_error *err)
 {
     const double absent = NAN;
@@ -199,6 +236,12 @@ int bk_stats_report_json(const bk_stats_report *r, FILE *out, bk_error *err)
     json_number(out, "a_value", r->have_b ? r->b.a : absent, 0);
     json_number(out, "mean_magnitude_above_mc", r->have_b ? r->b.mean : absent, 0);
     json_note(out, "b_value_note", r->have_b, r->b_note);
+    fprintf(out, "\"n_b_value\": %zu, \"b_value_small_sample\": %s, ", r->have_b ? r->b.n : 0,
+            r->have_b && r->b_small_sample ? "true" : "false");
+    json_number(out, "b_value_error_bootstrap", r->have_b_spread ? r->b_spread.b_sigma : absent, 0);
+    json_number(out, "mc_error_bootstrap", r->have_b_spread ? r->b_spread.mc_sigma : absent, 0);
+    fprintf(out, "\"bootstrap_resamples\": %zu, ", r->have_b_spread ? r->b_spread.n_used : 0);
+    json_gof(out, "gr_fit", r->have_gr_gof, &r->gr_gof);
     const bk_power_law *p = &r->potency_fit;
     int hp = r->have_potency_exponent;
     json_number(out, "potency_exponent", hp ? p->alpha : absent, 0);
@@ -206,6 +249,7 @@ int bk_stats_report_json(const bk_stats_report *r, FILE *out, bk_error *err)
     json_number(out, "potency_min", hp ? p->x_min : absent, 0);
     fprintf(out, "\"n_potency\": %zu, ", hp ? p->n : 0);
     json_note(out, "potency_note", hp, r->potency_note);
+    json_gof(out, "potency_fit", r->have_potency_gof, &r->potency_gof);
     const bk_recurrence *rec = &r->recurrence;
     int hr = r->have_recurrence;
     fprintf(out, "\"recurrence\": ");

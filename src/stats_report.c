@@ -23,6 +23,8 @@ void bk_stats_options_default(bk_stats_options *opt)
     opt->mc_correction = BK_MAXC_CORRECTION;
     opt->t_from = -INFINITY;
     opt->t_to = INFINITY;
+    opt->bootstrap = BK_BOOTSTRAP_DEFAULT;
+    opt->seed = BK_BOOTSTRAP_SEED;
 }
 
 int bk_stats_options_check(const bk_stats_options *opt, bk_error *err)
@@ -37,6 +39,9 @@ int bk_stats_options_check(const bk_stats_options *opt, bk_error *err)
         opt->t_from == INFINITY || opt->t_to == -INFINITY)
         return BK_FAIL(err, BK_ERR_INVALID, "time window [%g, %g) s: allowed from < to",
                        opt->t_from, opt->t_to);
+    if (opt->bootstrap > BK_BOOTSTRAP_MAX)
+        return BK_FAIL(err, BK_ERR_INVALID, "bootstrap samples %zu: allowed 0 .. %d", opt->bootstrap,
+                       BK_BOOTSTRAP_MAX);
     if (!opt->mc_auto) {
         double q = opt->mc / opt->dm;
         if (!(isfinite(q) && fabs(q) <= 1e15) || fabs(q - floor(q + 0.5)) > 1e-6)
@@ -141,6 +146,27 @@ static int fit_potency(bk_stats_report *r, const double *binned, bk_error *err)
     }
     bk_error inner = {0};
     int rc = bk_power_law_mle(p, count, p_min, &r->potency_fit, &inner);
+    if (rc == BK_OK && r->potency_fit.n < BK_B_MIN_EVENTS) {
+        snprintf(r->potency_note, sizeof r->potency_note,
+                 "%zu potencies at or above %g m: the exponent needs at least %d", r->potency_fit.n, p_min,
+                 BK_B_MIN_EVENTS);
+        free(p);
+        return BK_OK;
+    }
+    if (rc == BK_OK && r->options.bootstrap > 0) {
+        /* Tested as the GR fit is: a power law the potencies do not follow gives no exponent. */
+        rc = bk_power_law_gof(p, count, &r->potency_fit, r->options.bootstrap, r->options.seed + 2,
+                              &r->potency_gof, &inner);
+        if (rc == BK_OK && (r->have_potency_gof = 1, r->potency_gof.p < BK_GOF_LEVEL)) {
+            snprintf(r->potency_note, sizeof r->potency_note,
+                     "the %zu potencies at or above %g m do not follow a power law: KS distance %.4f to the "
+                     "fitted one, bootstrap p = %.3g < %g (%zu synthetic samples)",
+                     r->potency_gof.n, p_min, r->potency_gof.d, r->potency_gof.p, BK_GOF_LEVEL,
+                     r->potency_gof.n_synthetic);
+            free(p);
+            return BK_OK;
+        }
+    }
     free(p);
     if (rc == BK_OK) {
         r->have_potency_exponent = 1;
@@ -190,6 +216,37 @@ static int ks_halves(bk_stats_report *r, const double *binned, bk_error *err)
     return note_or_fail(rc, &inner, r->ks_note, sizeof r->ks_note, err);
 }
 
+/* The GR fit above Mc tested against its magnitudes, and b's and Mc's bootstrap errors: a
+ * fit the test rejects gives no b-value, and the note says why. */
+static int test_gr(bk_stats_report *r, bk_error *err)
+{
+    const bk_stats_options *o = &r->options;
+    r->have_b = 1;
+    r->b_small_sample = r->b.n < BK_B_SMALL_SAMPLE;
+    if (o->bootstrap == 0)
+        return BK_OK;
+    bk_error inner = {0};
+    int rc = bk_gr_gof(r->magnitude, r->n_events, &r->b, o->bootstrap, o->seed, &r->gr_gof, &inner);
+    if (rc != BK_OK)
+        return note_or_fail(rc, &inner, r->b_note, sizeof r->b_note, err);
+    r->have_gr_gof = 1;
+    if (r->gr_gof.p < BK_GOF_LEVEL) {
+        r->have_b = 0;
+        snprintf(r->b_note, sizeof r->b_note,
+                 "the %zu magnitudes at or above Mc = %g are not Gutenberg-Richter distributed: "
+                 "KS distance %.4f to the fitted law, bootstrap p = %.3g < %g (%zu synthetic samples)",
+                 r->gr_gof.n, r->mc, r->gr_gof.d, r->gr_gof.p, BK_GOF_LEVEL, r->gr_gof.n_synthetic);
+        return BK_OK;
+    }
+    bk_b_options bo = {o->dm, o->mc_auto, r->mc, o->mc_correction};
+    rc = bk_b_bootstrap(r->magnitude, r->n_events, &bo, o->bootstrap, o->seed + 1, &r->b_spread, &inner);
+    if (rc == BK_OK)
+        r->have_b_spread = 1;
+    else if (rc != BK_ERR_INVALID)
+        return note_or_fail(rc, &inner, r->b_note, sizeof r->b_note, err);
+    return BK_OK;
+}
+
 /* Everything that needs Mc. */
 static int above_mc(bk_stats_report *r, bk_error *err)
 {
@@ -219,7 +276,7 @@ static int above_mc(bk_stats_report *r, bk_error *err)
 
     rc = bk_b_value(r->magnitude, r->n_events, r->mc, o->dm, &r->b, &inner);
     if (rc == BK_OK)
-        r->have_b = 1;
+        rc = test_gr(r, err);
     else
         rc = note_or_fail(rc, &inner, r->b_note, sizeof r->b_note, err);
     if (rc == BK_OK && r->potency)

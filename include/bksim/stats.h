@@ -105,14 +105,67 @@ typedef struct bk_b_estimate {
     double a;           /* log10(n) + b Mc */
 } bk_b_estimate;
 
+/* Fewer magnitudes at or above Mc than this give no b-value (SeismoStats' worked example of
+ * 24 still computes); fewer than BK_B_SMALL_SAMPLE carry a small-sample warning (the
+ * relative error of b is about 1/sqrt(n): 14 % at 50). */
+#define BK_B_MIN_EVENTS 10
+#define BK_B_SMALL_SAMPLE 50
+
 /* The b-value of the finite magnitudes m[0..n) at or above mc, which must be a bin centre
- * (a multiple of dm to within 1e-6 of a bin); BK_ERR_INVALID when fewer than 2 magnitudes
- * are at or above Mc.  Magnitudes below Mc are ignored. */
+ * (a multiple of dm to within 1e-6 of a bin); BK_ERR_INVALID when fewer than
+ * BK_B_MIN_EVENTS magnitudes are at or above Mc, or all of them fall in one bin (no spread
+ * to estimate a slope from).  Magnitudes below Mc are ignored. */
 int bk_b_value(const double *m, size_t n, double mc, double dm, bk_b_estimate *out,
                bk_error *err);
 /* Shi & Bolt's standard error of b for the magnitudes m[0..n) as given (no binning, no
  * threshold), n >= 2: ln(10) b^2 sqrt(sum (m_i - mean)^2 / (n (n - 1))). */
 int bk_shi_bolt(const double *m, size_t n, double b, double *sigma, bk_error *err);
+
+/* ------------------------------------------- goodness of fit, bootstrap --- */
+
+/* Bootstrap sizes allowed; the report's default, and its seed (any fixed value: reports are
+ * reproducible). */
+#define BK_BOOTSTRAP_MAX 1000000
+#define BK_BOOTSTRAP_DEFAULT 1000
+#define BK_BOOTSTRAP_SEED 20261127UL
+/* A fit whose goodness-of-fit p-value is below this does not describe its sample: the
+ * report gives no parameter for it (Clauset et al. reject at 0.1, a test of the fit; here
+ * the bar is for withholding a number, and a true law passes it 99 times in 100). */
+#define BK_GOF_LEVEL 0.01
+
+typedef struct bk_gof {
+    size_t n;            /* values the fit describes (at or above its threshold) */
+    double d;            /* Kolmogorov-Smirnov distance between them and the fitted law */
+    double p;            /* fraction of n_synthetic samples drawn from the fitted law, each
+                            refitted, at least d from their own fit */
+    size_t n_synthetic;
+} bk_gof;
+
+/* The binned Gutenberg-Richter law of fit (bk_b_value's, on m[0..n)) against the magnitudes
+ * it was fitted to: above Mc the bin offsets are geometric, P(k) = (1 - q) q^k with
+ * q = 10^(-b dm); synthetic samples of the same size are drawn from it and refitted by the
+ * same estimator.  seed: GSL MT19937's. */
+int bk_gr_gof(const double *m, size_t n, const bk_b_estimate *fit, size_t n_synthetic, unsigned long seed,
+              bk_gof *out, bk_error *err);
+
+/* How b and Mc are estimated on a resample: Mc by maximum curvature plus mc_correction
+ * (mc_auto) or the given mc, in bins of dm. */
+typedef struct bk_b_options {
+    double dm;
+    int mc_auto;
+    double mc, mc_correction;
+} bk_b_options;
+
+typedef struct bk_b_spread {
+    size_t n_resamples, n_used; /* resamples drawn; those that gave a b-value */
+    double b_sigma;             /* standard deviation of b over them */
+    double mc_sigma;            /* of Mc (0 for a given Mc) */
+} bk_b_spread;
+
+/* Bootstrap standard errors of b and Mc: the n magnitudes resampled with replacement
+ * n_resamples times, Mc and b estimated on each as opt says. */
+int bk_b_bootstrap(const double *m, size_t n, const bk_b_options *opt, size_t n_resamples, unsigned long seed,
+                   bk_b_spread *out, bk_error *err);
 
 /* ------------------------------------------------------- potency exponent --- */
 
@@ -127,6 +180,10 @@ typedef struct bk_power_law {
  * BK_ERR_INVALID when fewer than 2 values are at or above x_min, or all equal x_min. */
 int bk_power_law_mle(const double *x, size_t n, double x_min, bk_power_law *out,
                      bk_error *err);
+/* The power law of fit (x_min fixed) against the values x >= x_min it describes, as
+ * bk_gr_gof: synthetic samples drawn from it and refitted by bk_power_law_mle's estimator. */
+int bk_power_law_gof(const double *x, size_t n, const bk_power_law *fit, size_t n_synthetic,
+                     unsigned long seed, bk_gof *out, bk_error *err);
 
 /* ------------------------------------------------------------------ sizes --- */
 
@@ -192,6 +249,10 @@ typedef struct bk_stats_options {
     /* s: only events starting in [t_from, t_to) count (a spin-up left out); default the
      * whole catalog (-inf, +inf) */
     double t_from, t_to;
+    /* Synthetic samples of the goodness-of-fit tests and resamples of the bootstrap errors
+     * (BK_BOOTSTRAP_DEFAULT; 0: neither, the fits reported untested), and their seed. */
+    size_t bootstrap;
+    unsigned long seed;
 } bk_stats_options;
 
 void bk_stats_options_default(bk_stats_options *opt);
@@ -252,8 +313,15 @@ typedef struct bk_stats_report {
     int have_b;
     bk_b_estimate b;
     char b_note[BK_ERROR_MESSAGE_LEN];
+    int b_small_sample;            /* fewer than BK_B_SMALL_SAMPLE events above Mc */
+    int have_gr_gof;               /* the GR fit tested (a b was estimated, bootstrap > 0) */
+    bk_gof gr_gof;                 /* when p < BK_GOF_LEVEL, have_b is 0 and b_note says why */
+    int have_b_spread;
+    bk_b_spread b_spread;          /* bootstrap errors of b and Mc */
     int have_potency_exponent;
     bk_power_law potency_fit;
+    int have_potency_gof;
+    bk_gof potency_gof;            /* when p < BK_GOF_LEVEL, have_potency_exponent is 0 */
     int potency_threshold_from_mc; /* 1: P_min is the potency of Mc - dm/2 */
     double magnitude_offset;       /* M - (2/3) log10 P when that holds for every event */
     char potency_note[BK_ERROR_MESSAGE_LEN];

@@ -35,7 +35,7 @@ static const char *const usage_text =
     "                       print columns for gnuplot and shell tools\n"
     "  export OUT.h5 --events\n"
     "                       print the event catalog /events as TSV\n"
-    "  stats FILE [--table NAME] [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
+    "  stats FILE [--table NAME] [--mc auto|VALUE] [--bin DM] [--from T] [--to T] [--bootstrap N]\n"
     "        [--json] [--tsv DIR]\n"
     "                       earthquake statistics of the rupture catalog /ruptures in FILE\n"
     "                       (else /events; --table events: the time-window catalog)\n"

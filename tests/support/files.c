@@ -83,3 +83,16 @@ int remove_tree(const char *path)
     }
     return rmdir(path) == 0 ? rc : -1;
 }
+
+char *written_text(FILE *f)
+{
+    long size = ftell(f);
+    if (size < 0 || fseek(f, 0, SEEK_SET) != 0)
+        return NULL;
+    char *text = calloc((size_t)size + 1, 1);
+    if (text && fread(text, 1, (size_t)size, f) != (size_t)size) {
+        free(text);
+        return NULL;
+    }
+    return text;
+}

@@ -4,6 +4,7 @@
 #define TEST_FILES_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 /* 1 when path names anything (file or directory), else 0. */
 int path_exists(const char *path);
@@ -18,5 +19,7 @@ int write_text(const char *path, const char *text);
 int copy_file(const char *src, const char *dst);
 /* rm -rf path: returns 0 when nothing of it is left (or there was none), else -1. */
 int remove_tree(const char *path);
+/* Everything written to f so far (a tmpfile()), as a string to free; NULL on failure. */
+char *written_text(FILE *f);
 
 #endif
