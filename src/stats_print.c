@@ -119,6 +119,20 @@ int bk_stats_report_text(const bk_stats_report *r, FILE *out, bk_error *err)
                 r->recurrence.n_events, r->recurrence.mean, r->recurrence.sd, r->recurrence.cv);
     else
         fprintf(out, "recurrence: not available: %s\n", r->recurrence_note);
+    if (r->n_interevent > 0) {
+        fprintf(out, "interevent times (Corral 2004: theta = tau R, R the rate above the threshold; "
+                     "gamma fit by maximum likelihood; 1 for a Poisson process):\n");
+        fprintf(out, "  %10s %8s %12s %8s %16s %10s\n", "M >=", "events", "R [1/s]", "CV", "gamma shape",
+                "scale");
+        for (size_t k = 0; k < r->n_interevent; ++k) {
+            const bk_interevent *ie = &r->interevent[k];
+            fprintf(out, "  %10.4g %8zu %12.6g %8.4f %8.4f +- %5.4f %10.4f%s\n", ie->m_min, ie->n_events, ie->rate,
+                    ie->cv, ie->gamma_shape, ie->gamma_shape_sigma, ie->gamma_scale,
+                    ie->n_zero ? " (zero intervals left out)" : "");
+        }
+    } else {
+        fprintf(out, "interevent times: not available: %s\n", r->interevent_note);
+    }
     if (r->have_sizes)
         fprintf(out, "sizes: %zu complete events, 1 to %d blocks, mean %.4g\n", r->sizes.n_events,
                 (int)r->sizes.max_size, r->sizes.mean);
@@ -265,6 +279,26 @@ int bk_stats_report_json(const bk_stats_report *r, FILE *out, bk_error *err)
         fprintf(out, "null, ");
     }
     json_note(out, "recurrence_note", hr, r->recurrence_note);
+    fprintf(out, "\"interevent\": [");
+    for (size_t k = 0; k < r->n_interevent; ++k) {
+        const bk_interevent *ie = &r->interevent[k];
+        fprintf(out, "%s{", k ? ", " : "");
+        json_number(out, "magnitude_min", ie->m_min, 0);
+        json_count(out, "n_events", ie->n_events);
+        json_number(out, "rate", ie->rate, 0);
+        json_number(out, "cv", ie->cv, 0);
+        json_count(out, "zero_intervals", ie->n_zero);
+        json_number(out, "gamma_shape", ie->gamma_shape, 0);
+        json_number(out, "gamma_shape_error", ie->gamma_shape_sigma, 0);
+        json_number(out, "gamma_scale", ie->gamma_scale, 1);
+        fprintf(out, "}");
+    }
+    fprintf(out, "], ");
+    if (r->n_interevent == 0) {
+        fprintf(out, "\"interevent_note\": ");
+        json_string_value(out, r->interevent_note);
+        fprintf(out, ", ");
+    }
     fprintf(out, "\"sizes\": ");
     if (r->have_sizes) {
         fprintf(out, "{");
@@ -432,6 +466,25 @@ int bk_stats_report_tsv(const bk_stats_report *r, const char *dir, bk_error *err
             return err ? err->status : BK_ERR_IO;
         for (size_t i = 0; i < r->recurrence.n_intervals; ++i)
             fprintf(f, "%.17g\t%.17g\n", r->recurrence.t[i], r->recurrence.interval[i]);
+        if ((rc = close_table(f, path, err)) != BK_OK)
+            return rc;
+    }
+    if (r->n_interevent > 0) {
+        /* One block per threshold, blank lines between (gnuplot's index). */
+        if (!(f = open_table(dir, "interevent.tsv", path, sizeof path,
+                             "# magnitude_min[1]\ttheta[1]\tdensity[1]\tgamma_fit[1]", err)))
+            return err ? err->status : BK_ERR_IO;
+        for (size_t k = 0; k < r->n_interevent; ++k) {
+            const bk_interevent *ie = &r->interevent[k];
+            double norm = 1.0 / (tgamma(ie->gamma_shape) * pow(ie->gamma_scale, ie->gamma_shape));
+            for (size_t b = 0; b < ie->n_bins; ++b) {
+                double x = ie->theta[b];
+                fprintf(f, "%.17g\t%.17g\t%.17g\t%.17g\n", ie->m_min, x, ie->density[b],
+                        norm * pow(x, ie->gamma_shape - 1.0) * exp(-x / ie->gamma_scale));
+            }
+            if (k + 1 < r->n_interevent)
+                fprintf(f, "\n\n");
+        }
         if ((rc = close_table(f, path, err)) != BK_OK)
             return rc;
     }

@@ -216,6 +216,36 @@ static int ks_halves(bk_stats_report *r, const double *binned, bk_error *err)
     return note_or_fail(rc, &inner, r->ks_note, sizeof r->ks_note, err);
 }
 
+/* Interevent times at Mc and every BK_INTEREVENT_STEP above it while enough events remain
+ * (binned magnitudes, as every statistic above Mc). */
+static int interevent(bk_stats_report *r, const double *binned, bk_error *err)
+{
+    bk_error inner = {0};
+    size_t k = 0;
+    for (; k < BK_INTEREVENT_THRESHOLDS; ++k) {
+        double m_min = r->mc + BK_INTEREVENT_STEP * (double)k - 0.5 * r->options.dm;
+        size_t count = 0;
+        for (size_t i = 0; i < r->n_events; ++i)
+            count += binned[i] >= m_min;
+        if (count < BK_INTEREVENT_MIN_EVENTS)
+            break;
+        int rc = bk_interevent_build(r->t_start, binned, r->n_events, m_min, r->duration,
+                                     BK_INTEREVENT_BINS_PER_DECADE, &r->interevent[k], &inner);
+        if (rc != BK_OK) {
+            if (k == 0)
+                return note_or_fail(rc, &inner, r->interevent_note, sizeof r->interevent_note, err);
+            break;
+        }
+        r->interevent[k].m_min = r->mc + BK_INTEREVENT_STEP * (double)k; /* the bin centre, as Mc */
+        r->n_interevent = k + 1;
+    }
+    if (r->n_interevent == 0 && !r->interevent_note[0])
+        snprintf(r->interevent_note, sizeof r->interevent_note,
+                 "fewer than %d events at or above Mc = %g: interevent times need that many", BK_INTEREVENT_MIN_EVENTS,
+                 r->mc);
+    return BK_OK;
+}
+
 /* The GR fit above Mc tested against its magnitudes, and b's and Mc's bootstrap errors: a
  * fit the test rejects gives no b-value, and the note says why. */
 static int test_gr(bk_stats_report *r, bk_error *err)
@@ -289,6 +319,8 @@ static int above_mc(bk_stats_report *r, bk_error *err)
         else
             rc = note_or_fail(rc, &inner, r->recurrence_note, sizeof r->recurrence_note, err);
     }
+    if (rc == BK_OK)
+        rc = interevent(r, binned, err);
     if (rc == BK_OK)
         rc = ks_halves(r, binned, err);
     free(binned);
@@ -376,6 +408,7 @@ static int compute(bk_stats_report *r, const bk_event_table *t, bk_error *err)
         const char *none = "no complete event with a finite t_start and magnitude";
         snprintf(r->b_note, sizeof r->b_note, "%s", none);
         snprintf(r->recurrence_note, sizeof r->recurrence_note, "%s", none);
+        snprintf(r->interevent_note, sizeof r->interevent_note, "%s", none);
         snprintf(r->ks_note, sizeof r->ks_note, "%s", none);
         if (r->has_potency)
             snprintf(r->potency_note, sizeof r->potency_note, "%s", none);
@@ -387,6 +420,7 @@ static int compute(bk_stats_report *r, const bk_event_table *t, bk_error *err)
         /* e.g. magnitudes spanning too many bins: the message says so. */
         rc = note_or_fail(rc, &inner, r->b_note, sizeof r->b_note, err);
         snprintf(r->recurrence_note, sizeof r->recurrence_note, "%s", r->b_note);
+        snprintf(r->interevent_note, sizeof r->interevent_note, "%s", r->b_note);
         snprintf(r->ks_note, sizeof r->ks_note, "%s", r->b_note);
         if (r->has_potency)
             snprintf(r->potency_note, sizeof r->potency_note, "%s", r->b_note);
@@ -438,6 +472,8 @@ void bk_stats_report_free(bk_stats_report *r)
     free(r->potency);
     bk_mfd_free(&r->mfd);
     bk_recurrence_free(&r->recurrence);
+    for (size_t k = 0; k < r->n_interevent; ++k)
+        bk_interevent_free(&r->interevent[k]);
     bk_size_dist_free(&r->sizes);
     free(r);
 }

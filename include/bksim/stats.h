@@ -220,6 +220,35 @@ int bk_recurrence_intervals(const double *t, const double *m, size_t n, double m
                             bk_recurrence *out, bk_error *err);
 void bk_recurrence_free(bk_recurrence *rec);
 
+/* ------------------------------------------------------ interevent times --- */
+
+/* Thresholds of the report: Mc, Mc + 0.5, Mc + 1, Mc + 1.5, each with at least
+ * BK_INTEREVENT_MIN_EVENTS events; logarithmic bins per decade of theta. */
+#define BK_INTEREVENT_THRESHOLDS 4
+#define BK_INTEREVENT_STEP 0.5
+#define BK_INTEREVENT_MIN_EVENTS 30
+#define BK_INTEREVENT_BINS_PER_DECADE 5
+
+typedef struct bk_interevent {
+    double m_min;            /* the threshold */
+    size_t n_events, n_intervals;
+    double rate;             /* R = events at or above m_min over the observed span, 1/s */
+    double cv;               /* of the intervals */
+    size_t n_zero;           /* zero intervals (events starting together): not in the fit or bins */
+    double gamma_shape, gamma_shape_sigma, gamma_scale; /* ML fit of theta = tau R */
+    size_t n_bins;
+    double *theta;           /* geometric centres of the logarithmic bins */
+    double *density;         /* per unit theta: count / (positive intervals x bin width) */
+} bk_interevent;
+
+/* Interevent times of the events with m >= m_min (m may be NULL: every event) over a span
+ * of duration seconds, rescaled by their rate (Corral 2004; src/stats_interevent.c): CV,
+ * gamma fit, density on bins_per_decade logarithmic bins.  At least 3 events and 2
+ * positive intervals that differ. */
+int bk_interevent_build(const double *t, const double *m, size_t n, double m_min, double duration,
+                        size_t bins_per_decade, bk_interevent *out, bk_error *err);
+void bk_interevent_free(bk_interevent *ie);
+
 /* ------------------------------------------------------ Kolmogorov-Smirnov --- */
 
 /* The Kolmogorov survival function Q_KS(lambda) = 2 sum_{j>=1} (-1)^(j-1) exp(-2 j^2 lambda^2)
@@ -328,6 +357,9 @@ typedef struct bk_stats_report {
     int have_recurrence;
     bk_recurrence recurrence;      /* events at or above Mc */
     char recurrence_note[BK_ERROR_MESSAGE_LEN];
+    size_t n_interevent;           /* thresholds with interevent statistics (0: see the note) */
+    bk_interevent interevent[BK_INTEREVENT_THRESHOLDS];
+    char interevent_note[BK_ERROR_MESSAGE_LEN];
     int have_sizes;
     bk_size_dist sizes;            /* complete events, any magnitude */
     char sizes_note[BK_ERROR_MESSAGE_LEN];
@@ -353,8 +385,8 @@ int bk_stats_report_json(const bk_stats_report *report, FILE *out, bk_error *err
  * '#' header line of column names and units: mfd.tsv (magnitude, incremental, cumulative),
  * gr_fit.tsv (the fitted cumulative count 10^(a - b M) from Mc up), sizes.tsv (n_blocks,
  * count; sizes that occur), sizes_log2.tsv (sizes 2^j..2^(j+1)-1, count, count per size),
- * intervals.tsv (t_start, interval of the events >= Mc), potency_ccdf.tsv (potency, events
- * at or above it).  A table whose statistic is unavailable is not written. */
+ * intervals.tsv (t_start, interval of the events >= Mc), interevent.tsv (threshold, theta,
+ * density, gamma fit; a block per threshold), potency_ccdf.tsv (potency, events at or above it).  A table whose statistic is unavailable is not written. */
 int bk_stats_report_tsv(const bk_stats_report *report, const char *dir, bk_error *err);
 
 #endif

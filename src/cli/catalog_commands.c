@@ -36,7 +36,8 @@ static const char *const stats_help =
     "Statistics of an earthquake catalog in the HDF5 file FILE (a table with at least\n"
     "t_start and magnitude): magnitude-frequency distribution, completeness magnitude Mc,\n"
     "b-value (Aki-Utsu maximum likelihood, Shi & Bolt error), potency exponent, event\n"
-    "sizes, recurrence intervals, and a KS test of the two halves of the run.  Events still\n"
+    "sizes, recurrence intervals, interevent times rescaled by the rate (Corral 2004), and\n"
+    "a KS test of the two halves of the run.  Events still\n"
     "running at the end (complete = 0) are left out.  The catalog is the rupture catalog\n"
     "/ruptures (connected slip episodes: one row per rupture); a file without it (an older\n"
     "bksim output, another program's catalog) falls back to /events, and the report says so\n"
@@ -58,7 +59,7 @@ static const char *const stats_help =
     "  --json            print one JSON object instead of the text report\n"
     "  --tsv DIR         also write tables for gnuplot to DIR (created if missing): mfd.tsv,\n"
     "                    gr_fit.tsv, sizes.tsv, sizes_log2.tsv, intervals.tsv,\n"
-    "                    potency_ccdf.tsv\n";
+    "                    interevent.tsv, potency_ccdf.tsv\n";
 
 static const char *const summary_help =
     "usage: bksim summary DIR [--table NAME] [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
