@@ -94,6 +94,23 @@ int bk_stats_report_text(const bk_stats_report *r, FILE *out, bk_error *err)
                      "synthetic samples, refitted)\n",
                 r->gr_gof.p < BK_GOF_LEVEL ? "not" : "consistent with", r->gr_gof.d, r->gr_gof.p,
                 r->gr_gof.n_synthetic);
+    if (r->have_b_positive) {
+        const bk_b_positive_estimate *bp = &r->b_positive;
+        fprintf(out, "b-positive (van der Elst 2021; differences of successive magnitudes >= %g, binned "
+                     "maximum likelihood): %.4f +- %.4f over %zu differences",
+                bp->dmc, bp->fit.b, bp->fit.sigma, bp->fit.n);
+        if (isfinite(bp->a))
+            fprintf(out, ", a = %.4f (SeismoStats' a-positive)", bp->a);
+        fprintf(out, "\n");
+    } else if (r->have_mc) {
+        fprintf(out, "b-positive: not available: %s\n", r->b_positive_note);
+    }
+    if (r->have_mc_stability)
+        fprintf(out, "Mc by b-value stability (Woessner & Wiemer 2005, range 0.5): %.6g (b = %.4f, |b_avg - b| = %.3g "
+                     "sigma)\n",
+                r->mc_stability.mc, r->mc_stability.b, r->mc_stability.diff);
+    else if (r->have_mfd)
+        fprintf(out, "Mc by b-value stability: not available: %s\n", r->mc_stability_note);
     if (r->have_potency_exponent) {
         const bk_power_law *p = &r->potency_fit;
         fprintf(out, "potency exponent: alpha = %.4f +- %.4f over %zu events with P >= %.6g m "
@@ -256,6 +273,13 @@ int bk_stats_report_json(const bk_stats_report *r, FILE *out, bk_error *err)
     json_number(out, "mc_error_bootstrap", r->have_b_spread ? r->b_spread.mc_sigma : absent, 0);
     fprintf(out, "\"bootstrap_resamples\": %zu, ", r->have_b_spread ? r->b_spread.n_used : 0);
     json_gof(out, "gr_fit", r->have_gr_gof, &r->gr_gof);
+    json_number(out, "b_positive", r->have_b_positive ? r->b_positive.fit.b : absent, 0);
+    json_number(out, "b_positive_error", r->have_b_positive ? r->b_positive.fit.sigma : absent, 0);
+    fprintf(out, "\"n_b_positive\": %zu, ", r->have_b_positive ? r->b_positive.fit.n : 0);
+    json_number(out, "a_positive", r->have_b_positive ? r->b_positive.a : absent, 0);
+    json_note(out, "b_positive_note", r->have_b_positive || !r->have_mc, r->b_positive_note);
+    json_number(out, "mc_b_stability", r->have_mc_stability ? r->mc_stability.mc : absent, 0);
+    json_note(out, "mc_b_stability_note", r->have_mc_stability || !r->have_mfd, r->mc_stability_note);
     const bk_power_law *p = &r->potency_fit;
     int hp = r->have_potency_exponent;
     json_number(out, "potency_exponent", hp ? p->alpha : absent, 0);

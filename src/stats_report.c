@@ -216,6 +216,31 @@ static int ks_halves(bk_stats_report *r, const double *binned, bk_error *err)
     return note_or_fail(rc, &inner, r->ks_note, sizeof r->ks_note, err);
 }
 
+/* b-positive at Mc and Mc by b-value stability, beside the Aki-Utsu b and maximum curvature.
+ * Neither is tested for fit here: they answer other questions (short-term incompleteness,
+ * the choice of Mc). */
+static int other_estimators(bk_stats_report *r, bk_error *err)
+{
+    const bk_stats_options *o = &r->options;
+    bk_error inner = {0};
+    int rc = bk_b_positive(r->magnitude, r->t_start, r->n_events, r->mc, o->dm, o->dm, &r->b_positive, &inner);
+    if (rc == BK_OK && r->b_positive.fit.n < BK_B_MIN_EVENTS) {
+        snprintf(r->b_positive_note, sizeof r->b_positive_note,
+                 "%zu positive magnitude differences at or above %g: b-positive needs at least %d",
+                 r->b_positive.fit.n, o->dm, BK_B_MIN_EVENTS);
+    } else if (rc == BK_OK) {
+        r->have_b_positive = 1;
+    } else if ((rc = note_or_fail(rc, &inner, r->b_positive_note, sizeof r->b_positive_note, err)) != BK_OK) {
+        return rc;
+    }
+    rc = bk_mc_b_stability(r->magnitude, r->n_events, o->dm, 0.5, &r->mc_stability, &inner);
+    if (rc == BK_OK)
+        r->have_mc_stability = 1;
+    else
+        return note_or_fail(rc, &inner, r->mc_stability_note, sizeof r->mc_stability_note, err);
+    return BK_OK;
+}
+
 /* Interevent times at Mc and every BK_INTEREVENT_STEP above it while enough events remain
  * (binned magnitudes, as every statistic above Mc). */
 static int interevent(bk_stats_report *r, const double *binned, bk_error *err)
@@ -319,6 +344,8 @@ static int above_mc(bk_stats_report *r, bk_error *err)
         else
             rc = note_or_fail(rc, &inner, r->recurrence_note, sizeof r->recurrence_note, err);
     }
+    if (rc == BK_OK)
+        rc = other_estimators(r, err);
     if (rc == BK_OK)
         rc = interevent(r, binned, err);
     if (rc == BK_OK)

@@ -121,6 +121,40 @@ int bk_b_value(const double *m, size_t n, double mc, double dm, bk_b_estimate *o
  * threshold), n >= 2: ln(10) b^2 sqrt(sum (m_i - mean)^2 / (n (n - 1))). */
 int bk_shi_bolt(const double *m, size_t n, double b, double *sigma, bk_error *err);
 
+/* The binned maximum-likelihood b of Tinti & Mulargia (1987), SeismoStats' classic
+ * estimator: beta = ln(1 + dm / mean(M - Mc)) / dm over M >= Mc - dm/2 (Mc need not be a
+ * bin centre), b = beta / ln 10, Shi & Bolt's error with the population sd over
+ * sqrt(n - 1) (NaN for one magnitude).  At least 1 magnitude and a positive mean excess. */
+int bk_b_tinti(const double *m, size_t n, double mc, double dm, bk_b_estimate *out, bk_error *err);
+
+/* b-positive (van der Elst 2021; src/stats_positive.c) as SeismoStats computes it: the events
+ * M >= Mc - dm/2 in time order (t NULL: array order; ties in array order), the differences
+ * of successive magnitudes at least dMc - dm/2, rounded to dm, fitted by bk_b_tinti with
+ * reference dMc (SeismoStats' default dMc is dm). */
+typedef struct bk_b_positive_estimate {
+    double mc, dmc;
+    size_t n_events;        /* events at or above Mc */
+    bk_b_estimate fit;      /* of the differences: fit.n of them, fit.b, fit.sigma */
+    double a;               /* log10 of their count over the fraction of the span the kept
+                               pairs cover (SeismoStats' APositiveAValueEstimator; NaN
+                               without times) */
+} bk_b_positive_estimate;
+int bk_b_positive(const double *m, const double *t, size_t n, double mc, double dm, double dmc,
+                  bk_b_positive_estimate *out, bk_error *err);
+
+/* Mc by b-value stability (Woessner & Wiemer 2005; src/stats_mc.c) as SeismoStats computes
+ * it: candidates from the smallest magnitude up in steps of dm (the last steps - 1 left out,
+ * steps = ceil(range / dm)); the first whose bk_b_tinti b differs from the sum of the
+ * b-values at Mc, Mc + dm, ... below Mc + range (and at most the largest magnitude) over
+ * steps by at most its own error. */
+typedef struct bk_mc_stability {
+    int found;
+    double mc, b, diff;     /* the Mc, its b, |b_avg - b| / sigma there */
+    double range;
+    size_t steps, n_tested;
+} bk_mc_stability;
+int bk_mc_b_stability(const double *m, size_t n, double dm, double range, bk_mc_stability *out, bk_error *err);
+
 /* ------------------------------------------- goodness of fit, bootstrap --- */
 
 /* Bootstrap sizes allowed; the report's default, and its seed (any fixed value: reports are
@@ -347,6 +381,12 @@ typedef struct bk_stats_report {
     bk_gof gr_gof;                 /* when p < BK_GOF_LEVEL, have_b is 0 and b_note says why */
     int have_b_spread;
     bk_b_spread b_spread;          /* bootstrap errors of b and Mc */
+    int have_b_positive;
+    bk_b_positive_estimate b_positive; /* at Mc, dMc = dm, in start-time order */
+    char b_positive_note[BK_ERROR_MESSAGE_LEN];
+    int have_mc_stability;
+    bk_mc_stability mc_stability;  /* Mc by b-value stability, range 0.5 (beside maximum curvature) */
+    char mc_stability_note[BK_ERROR_MESSAGE_LEN];
     int have_potency_exponent;
     bk_power_law potency_fit;
     int have_potency_gof;
