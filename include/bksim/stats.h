@@ -283,6 +283,27 @@ int bk_interevent_build(const double *t, const double *m, size_t n, double m_min
                         size_t bins_per_decade, bk_interevent *out, bk_error *err);
 void bk_interevent_free(bk_interevent *ie);
 
+/* ------------------------------------------------------------ Omori-Utsu --- */
+
+#define BK_OMORI_MIN_EVENTS 10
+/* The 99 % quantile of chi-square with 2 degrees of freedom: the likelihood ratio of the
+ * Omori-Utsu law against a constant rate (K, c, p against one rate) above it is a decay. */
+#define BK_OMORI_LR_CHI2_2DOF_1PC 9.2103403719761836
+
+typedef struct bk_omori {
+    size_t n;
+    double start, end;        /* s after the mainshock: the window fitted */
+    double k, c, p;           /* n(t) = K / (t + c)^p, t from the mainshock; K in 1/s^(1-p) */
+    double k_sigma, c_sigma, p_sigma; /* from the observed information (NaN when singular) */
+    double log_likelihood;
+    double lr;                /* 2 (l - l_constant) */
+    int decays;               /* lr above BK_OMORI_LR_CHI2_2DOF_1PC and p > 0 */
+} bk_omori;
+
+/* Maximum-likelihood Omori-Utsu fit (Ogata 1983; src/stats_omori.c) of n >= BK_OMORI_MIN_EVENTS
+ * times t (s after the mainshock, in [start, end], any order). */
+int bk_omori_fit(const double *t, size_t n, double start, double end, bk_omori *out, bk_error *err);
+
 /* ------------------------------------------------------ Kolmogorov-Smirnov --- */
 
 /* The Kolmogorov survival function Q_KS(lambda) = 2 sum_{j>=1} (-1)^(j-1) exp(-2 j^2 lambda^2)
