@@ -3,12 +3,21 @@
  * b-values at Mc, Mc + dm, ... up to Mc + range by at most its own (Shi & Bolt) error.  As
  * SeismoStats computes it (4605c4e, seismostats/analysis/estimate_mc.py,
  * estimate_mc_b_stability, with its classic estimator, bk_b_tinti), numpy's floating-point
- * ranges included, so that its published values are reproduced. */
+ * ranges included, so that its published values are reproduced.
+ *
+ * And by the Kolmogorov-Smirnov method (Clauset, Shalizi & Newman 2009; Mizrahi, Nandan &
+ * Wiemer 2021), as SeismoStats' estimate_mc_ks: the lowest candidate whose magnitudes above
+ * it are at most as far from their GR fit (bk_b_tinti's b) as synthetic GR samples of the
+ * same size and b are from that law in a fraction p_pass of cases (0.1 by default); the
+ * synthetic samples, unlike bk_gr_gof's, are not refitted, as in SeismoStats, and come from
+ * a seeded MT19937 where SeismoStats' come from numpy's unseeded generator. */
 #include "bksim/stats.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <gsl/gsl_rng.h>
 
 /* The length of numpy's arange(start, stop, step): ceil((stop - start) / step). */
 static size_t arange_length(double start, double stop, double step)
@@ -76,4 +85,118 @@ int bk_mc_b_stability(const double *m, size_t n, double dm, double range, bk_mc_
                    "Mc by b-stability: none of the %zu candidates from %g up has a b-value within its error of the "
                    "mean over the next %g",
                    out->n_tested, to_bin(lo, dm), range);
+}
+
+/* The KS distance between binned magnitudes (bin offsets k >= 0 from Mc, sorted) and the
+ * binned GR law P(K <= k) = 1 - q^(k + 1), at the bin centres up to the largest (as
+ * SeismoStats' ks_test_gr evaluates it). */
+static double gr_distance(const long *k, size_t n, double q)
+{
+    double d = 0.0;
+    size_t i = 0;
+    for (long bin = 0; i < n; ++bin) {
+        while (i < n && k[i] <= bin)
+            ++i;
+        d = fmax(d, fabs((double)i / (double)n - (1.0 - pow(q, (double)(bin + 1)))));
+    }
+    return d;
+}
+
+static int compare_longs(const void *pa, const void *pb)
+{
+    long a = *(const long *)pa, b = *(const long *)pb;
+    return (a > b) - (a < b);
+}
+
+int bk_gr_ks_distance(const double *m, size_t n, double mc, double dm, double b, double *d, bk_error *err)
+{
+    long *k = malloc((n ? n : 1) * sizeof *k);
+    if (!k)
+        return BK_FAIL(err, BK_ERR_NOMEM, "out of memory for %zu magnitudes", n);
+    size_t count = 0;
+    for (size_t i = 0; i < n; ++i)
+        if (m[i] >= mc - 0.5 * dm)
+            k[count++] = (long)floor((m[i] - mc) / dm + 0.5 + 1e-9);
+    if (count == 0 || !(b > 0.0) || !(dm > 0.0)) {
+        free(k);
+        return BK_FAIL(err, BK_ERR_INVALID, "GR KS distance: %zu magnitudes at or above Mc = %g, b = %g, dm = %g",
+                       count, mc, b, dm);
+    }
+    qsort(k, count, sizeof *k, compare_longs);
+    *d = gr_distance(k, count, pow(10.0, -b * dm));
+    free(k);
+    return BK_OK;
+}
+
+int bk_mc_ks(const double *m, size_t n, double dm, double p_pass, size_t n_synthetic, unsigned long seed,
+             bk_mc_ks_result *out, bk_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!(isfinite(dm) && dm > 0.0) || !(p_pass > 0.0 && p_pass < 1.0) || n_synthetic < 1 ||
+        n_synthetic > BK_BOOTSTRAP_MAX)
+        return BK_FAIL(err, BK_ERR_INVALID,
+                       "Mc by the KS method: dm = %g, pass level %g, %zu synthetic samples: allowed dm > 0, 0 < level "
+                       "< 1, 1 .. %d samples",
+                       dm, p_pass, n_synthetic, BK_BOOTSTRAP_MAX);
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < n; ++i) {
+        if (!isfinite(m[i]))
+            return BK_FAIL(err, BK_ERR_INVALID, "Mc by the KS method: magnitude %zu is %g: must be finite", i, m[i]);
+        lo = fmin(lo, m[i]);
+        hi = fmax(hi, m[i]);
+    }
+    if (n < 2 || !(hi > lo))
+        return BK_FAIL(err, BK_ERR_INVALID, "Mc by the KS method: %zu magnitudes from %g to %g: needs a range", n, lo,
+                       hi);
+    long *k = malloc(n * sizeof *k), *synthetic = malloc(n * sizeof *synthetic);
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    if (!k || !synthetic || !rng) {
+        free(k);
+        free(synthetic);
+        if (rng)
+            gsl_rng_free(rng);
+        return BK_FAIL(err, BK_ERR_NOMEM, "out of memory for %zu magnitudes", n);
+    }
+    gsl_rng_set(rng, seed);
+    size_t candidates = arange_length(lo, hi, dm);
+    int rc = BK_FAIL(err, BK_ERR_INVALID,
+                     "Mc by the KS method: no candidate from %g to %g passes (p >= %g against its own GR fit)",
+                     to_bin(lo, dm), to_bin(hi, dm), p_pass);
+    for (size_t c = 0; c < candidates; ++c) {
+        double mc = to_bin(lo + (double)c * dm, dm);
+        bk_b_estimate fit;
+        bk_error ignored = {0};
+        if (bk_b_tinti(m, n, mc, dm, &fit, &ignored) != BK_OK)
+            continue;
+        size_t count = 0;
+        for (size_t i = 0; i < n; ++i)
+            if (m[i] >= mc - 0.5 * dm)
+                k[count++] = (long)floor((m[i] - mc) / dm + 0.5 + 1e-9);
+        if (count < 2)
+            continue;
+        qsort(k, count, sizeof *k, compare_longs);
+        double q = pow(10.0, -fit.b * dm), d = gr_distance(k, count, q);
+        size_t at_least = 0;
+        for (size_t s = 0; s < n_synthetic; ++s) {
+            for (size_t i = 0; i < count; ++i)
+                synthetic[i] = (long)floor(log(gsl_rng_uniform_pos(rng)) / log(q));
+            qsort(synthetic, count, sizeof *synthetic, compare_longs);
+            at_least += gr_distance(synthetic, count, q) >= d;
+        }
+        out->n_tested = c + 1;
+        out->mc = mc;
+        out->b = fit.b;
+        out->d = d;
+        out->p = (double)at_least / (double)n_synthetic;
+        out->n = count;
+        if (out->p >= p_pass) {
+            out->found = 1;
+            rc = BK_OK;
+            break;
+        }
+    }
+    free(k);
+    free(synthetic);
+    gsl_rng_free(rng);
+    return rc;
 }

@@ -1,5 +1,5 @@
-/* b-positive, its a-value, the classic binned b and Mc by b-value stability (src/stats_positive.c,
- * src/stats_mc.c) against SeismoStats' published values (swiss-seismological-service/
+/* b-positive, its a-value, the classic binned b, Mc by b-value stability and by the KS method
+ * (src/stats_positive.c, src/stats_mc.c) against SeismoStats' published values (swiss-seismological-service/
  * SeismoStats 4605c4e: docstrings and tests of seismostats/analysis/bvalue/positive.py,
  * avalue/positive.py, bvalue/classic.py, estimate_mc.py, tests/test_estimate_mc.py), to the
  * precision they print, and on seeded synthetic catalogs: b-positive recovers b where a
@@ -169,6 +169,46 @@ static void test_incompleteness(void **state)
     gsl_rng_free(rng);
 }
 
+/* Mc by the KS method: SeismoStats' distance, and the completeness of a synthetic catalog. */
+static void test_mc_ks(void **state)
+{
+    (void)state;
+    bk_error err = {0};
+    /* ks_test_gr(MAGNITUDES, mc = 1.0, delta_m = 0.1, b_value = 1): the observed distance,
+     * 0.14567176527571873 by SeismoStats 4605c4e (its test then compares it with stored
+     * synthetic distances: p = 0.0104). */
+    double d = 0.0;
+    assert_int_equal(bk_gr_ks_distance(MAGNITUDES, N_OF(MAGNITUDES), 1.0, 0.1, 1.0, &d, &err), BK_OK);
+    assert_close(d, 0.14567176527571873, 1e-14, 0.0);
+    /* 3000 GR magnitudes (b = 1) complete from 2.0, and below it detected with probability
+     * 10^(-3 (1.95 - M)): the KS method finds Mc at the completeness, where maximum curvature
+     * + 0.2 sits higher. */
+    enum { CAP = 20000 };
+    static double m[CAP];
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 2021);
+    size_t n = 0, complete = 0;
+    while (complete < 3000 && n < CAP) {
+        double mag = 1.0 + gsl_ran_exponential(rng, log10(exp(1.0)));
+        if (mag < 1.95 && gsl_rng_uniform(rng) >= pow(10.0, -3.0 * (1.95 - mag)))
+            continue;
+        complete += mag >= 1.95;
+        m[n++] = floor(mag / 0.1 + 0.5 + 1e-9) * 0.1;
+    }
+    bk_mc_ks_result ks;
+    assert_int_equal(bk_mc_ks(m, n, 0.1, 0.1, 200, 5, &ks, &err), BK_OK);
+    print_message("%zu magnitudes: Mc by KS = %.2f (b = %.4f, D = %.4f, p = %.3f, %zu candidates)\n", n, ks.mc, ks.b,
+                  ks.d, ks.p, ks.n_tested);
+    assert_true(ks.found);
+    assert_true(ks.mc > 1.85 && ks.mc < 2.25);
+    assert_close(ks.b, 1.0, 0.0, 0.1);
+    /* The same test, seeded: the same answer. */
+    bk_mc_ks_result again;
+    assert_int_equal(bk_mc_ks(m, n, 0.1, 0.1, 200, 5, &again, &err), BK_OK);
+    assert_true(again.mc == ks.mc && again.p == ks.p);
+    gsl_rng_free(rng);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -177,6 +217,7 @@ int main(void)
         cmocka_unit_test(test_a_positive),
         cmocka_unit_test(test_mc_b_stability),
         cmocka_unit_test(test_incompleteness),
+        cmocka_unit_test(test_mc_ks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -155,6 +155,22 @@ typedef struct bk_mc_stability {
 } bk_mc_stability;
 int bk_mc_b_stability(const double *m, size_t n, double dm, double range, bk_mc_stability *out, bk_error *err);
 
+/* Mc by the Kolmogorov-Smirnov method (src/stats_mc.c) as SeismoStats' estimate_mc_ks: the
+ * first candidate (from the smallest magnitude up in steps of dm) whose magnitudes at or
+ * above it pass a KS test against their bk_b_tinti GR fit at p >= p_pass, p the fraction of
+ * n_synthetic samples from that law at least as far from it.  out holds the last candidate
+ * tested (the passing one when found). */
+typedef struct bk_mc_ks_result {
+    int found;
+    double mc, b, d, p;
+    size_t n, n_tested;
+} bk_mc_ks_result;
+int bk_mc_ks(const double *m, size_t n, double dm, double p_pass, size_t n_synthetic, unsigned long seed,
+             bk_mc_ks_result *out, bk_error *err);
+/* The KS distance of bk_mc_ks (and SeismoStats' ks_test_gr) between the magnitudes at or
+ * above Mc and the binned GR law of slope b from Mc. */
+int bk_gr_ks_distance(const double *m, size_t n, double mc, double dm, double b, double *d, bk_error *err);
+
 /* ------------------------------------------- goodness of fit, bootstrap --- */
 
 /* Bootstrap sizes allowed; the report's default, and its seed (any fixed value: reports are
