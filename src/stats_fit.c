@@ -7,6 +7,7 @@
  * replacement, Mc and b estimated again on each resample).  Every draw comes from GSL's
  * MT19937 seeded by the caller: the same seed gives the same p-values and errors. */
 #include "bksim/stats.h"
+#include "stats_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -47,8 +48,8 @@ static int compare_longs(const void *pa, const void *pb)
 }
 
 /* The binned GR law above Mc is geometric in the bin offset: P(k) = (1 - q) q^k with
- * q = 10^(-b dm), CDF 1 - q^(k + 1).  D over the offsets k = 0 .. max (sorted in place). */
-static double geometric_distance(long *k, size_t n, double q)
+ * q = 10^(-b dm), CDF 1 - q^(k + 1) (stats_impl.h). */
+double bk_gr_distance(long *k, size_t n, double q)
 {
     qsort(k, n, sizeof *k, compare_longs);
     double d = 0.0;
@@ -108,13 +109,13 @@ int bk_gr_gof(const double *m, size_t n, const bk_b_estimate *fit, size_t n_synt
     gsl_rng_set(rng, seed);
     double q = pow(10.0, -fit->b * fit->dm);
     out->n = count;
-    out->d = geometric_distance(k, count, q);
+    out->d = bk_gr_distance(k, count, q);
     double log_q = log(q);
     size_t at_least = 0;
     for (size_t s = 0; s < n_synthetic; ++s) {
         for (size_t i = 0; i < count; ++i)
             synthetic[i] = (long)floor(log(gsl_rng_uniform_pos(rng)) / log_q);
-        double d = geometric_distance(synthetic, count, fitted_q(synthetic, count, fit->dm));
+        double d = bk_gr_distance(synthetic, count, fitted_q(synthetic, count, fit->dm));
         at_least += d >= out->d;
     }
     out->p = (double)at_least / (double)n_synthetic;

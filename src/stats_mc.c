@@ -12,6 +12,7 @@
  * synthetic samples, unlike bk_gr_gof's, are not refitted, as in SeismoStats, and come from
  * a seeded MT19937 where SeismoStats' come from numpy's unseeded generator. */
 #include "bksim/stats.h"
+#include "stats_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -31,21 +32,32 @@ static double to_bin(double x, double dx)
     return floor(x / dx + 0.5 + 1e-12) * dx;
 }
 
+/* The smallest and largest of n >= 2 finite magnitudes that differ. */
+static int magnitude_range(const double *m, size_t n, const char *what, double *lo, double *hi, bk_error *err)
+{
+    *lo = INFINITY;
+    *hi = -INFINITY;
+    for (size_t i = 0; i < n; ++i) {
+        if (!isfinite(m[i]))
+            return BK_FAIL(err, BK_ERR_INVALID, "%s: magnitude %zu is %g: must be finite", what, i, m[i]);
+        *lo = fmin(*lo, m[i]);
+        *hi = fmax(*hi, m[i]);
+    }
+    if (n < 2 || !(*hi > *lo))
+        return BK_FAIL(err, BK_ERR_INVALID, "%s: %zu magnitudes: needs at least 2 that differ", what, n);
+    return BK_OK;
+}
+
 int bk_mc_b_stability(const double *m, size_t n, double dm, double range, bk_mc_stability *out, bk_error *err)
 {
     memset(out, 0, sizeof *out);
     if (!(isfinite(dm) && dm > 0.0) || !(isfinite(range) && range >= dm))
         return BK_FAIL(err, BK_ERR_INVALID, "Mc by b-stability: dm = %g, range = %g: allowed 0 < dm <= range", dm,
                        range);
-    if (n < 2)
-        return BK_FAIL(err, BK_ERR_INVALID, "Mc by b-stability: %zu magnitudes: needs at least 2", n);
-    double lo = INFINITY, hi = -INFINITY;
-    for (size_t i = 0; i < n; ++i) {
-        if (!isfinite(m[i]))
-            return BK_FAIL(err, BK_ERR_INVALID, "Mc by b-stability: magnitude %zu is %g: must be finite", i, m[i]);
-        lo = fmin(lo, m[i]);
-        hi = fmax(hi, m[i]);
-    }
+    double lo, hi;
+    int rc = magnitude_range(m, n, "Mc by b-stability", &lo, &hi, err);
+    if (rc != BK_OK)
+        return rc;
     size_t steps = arange_length(0.0, range, dm);
     size_t n_candidates = arange_length(lo, hi, dm);
     if (n_candidates <= steps)
@@ -87,27 +99,6 @@ int bk_mc_b_stability(const double *m, size_t n, double dm, double range, bk_mc_
                    out->n_tested, to_bin(lo, dm), range);
 }
 
-/* The KS distance between binned magnitudes (bin offsets k >= 0 from Mc, sorted) and the
- * binned GR law P(K <= k) = 1 - q^(k + 1), at the bin centres up to the largest (as
- * SeismoStats' ks_test_gr evaluates it). */
-static double gr_distance(const long *k, size_t n, double q)
-{
-    double d = 0.0;
-    size_t i = 0;
-    for (long bin = 0; i < n; ++bin) {
-        while (i < n && k[i] <= bin)
-            ++i;
-        d = fmax(d, fabs((double)i / (double)n - (1.0 - pow(q, (double)(bin + 1)))));
-    }
-    return d;
-}
-
-static int compare_longs(const void *pa, const void *pb)
-{
-    long a = *(const long *)pa, b = *(const long *)pb;
-    return (a > b) - (a < b);
-}
-
 int bk_gr_ks_distance(const double *m, size_t n, double mc, double dm, double b, double *d, bk_error *err)
 {
     long *k = malloc((n ? n : 1) * sizeof *k);
@@ -122,8 +113,7 @@ int bk_gr_ks_distance(const double *m, size_t n, double mc, double dm, double b,
         return BK_FAIL(err, BK_ERR_INVALID, "GR KS distance: %zu magnitudes at or above Mc = %g, b = %g, dm = %g",
                        count, mc, b, dm);
     }
-    qsort(k, count, sizeof *k, compare_longs);
-    *d = gr_distance(k, count, pow(10.0, -b * dm));
+    *d = bk_gr_distance(k, count, pow(10.0, -b * dm));
     free(k);
     return BK_OK;
 }
@@ -138,16 +128,10 @@ int bk_mc_ks(const double *m, size_t n, double dm, double p_pass, size_t n_synth
                        "Mc by the KS method: dm = %g, pass level %g, %zu synthetic samples: allowed dm > 0, 0 < level "
                        "< 1, 1 .. %d samples",
                        dm, p_pass, n_synthetic, BK_BOOTSTRAP_MAX);
-    double lo = INFINITY, hi = -INFINITY;
-    for (size_t i = 0; i < n; ++i) {
-        if (!isfinite(m[i]))
-            return BK_FAIL(err, BK_ERR_INVALID, "Mc by the KS method: magnitude %zu is %g: must be finite", i, m[i]);
-        lo = fmin(lo, m[i]);
-        hi = fmax(hi, m[i]);
-    }
-    if (n < 2 || !(hi > lo))
-        return BK_FAIL(err, BK_ERR_INVALID, "Mc by the KS method: %zu magnitudes from %g to %g: needs a range", n, lo,
-                       hi);
+    double lo, hi;
+    int status = magnitude_range(m, n, "Mc by the KS method", &lo, &hi, err);
+    if (status != BK_OK)
+        return status;
     long *k = malloc(n * sizeof *k), *synthetic = malloc(n * sizeof *synthetic);
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
     if (!k || !synthetic || !rng) {
@@ -174,14 +158,12 @@ int bk_mc_ks(const double *m, size_t n, double dm, double p_pass, size_t n_synth
                 k[count++] = (long)floor((m[i] - mc) / dm + 0.5 + 1e-9);
         if (count < 2)
             continue;
-        qsort(k, count, sizeof *k, compare_longs);
-        double q = pow(10.0, -fit.b * dm), d = gr_distance(k, count, q);
+        double q = pow(10.0, -fit.b * dm), d = bk_gr_distance(k, count, q);
         size_t at_least = 0;
         for (size_t s = 0; s < n_synthetic; ++s) {
             for (size_t i = 0; i < count; ++i)
                 synthetic[i] = (long)floor(log(gsl_rng_uniform_pos(rng)) / log(q));
-            qsort(synthetic, count, sizeof *synthetic, compare_longs);
-            at_least += gr_distance(synthetic, count, q) >= d;
+            at_least += bk_gr_distance(synthetic, count, q) >= d;
         }
         out->n_tested = c + 1;
         out->mc = mc;
