@@ -41,6 +41,14 @@ static int offsets_above(const double *m, size_t n, double mc, double dm, long *
     return BK_OK;
 }
 
+gsl_rng *bk_stats_rng(unsigned long seed)
+{
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    if (rng)
+        gsl_rng_set(rng, seed);
+    return rng;
+}
+
 static int compare_longs(const void *pa, const void *pb)
 {
     long a = *(const long *)pa, b = *(const long *)pb;
@@ -98,7 +106,7 @@ int bk_gr_gof(const double *m, size_t n, const bk_b_estimate *fit, size_t n_synt
                        fit->mc);
     }
     long *synthetic = malloc(count * sizeof *synthetic);
-    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng *rng = bk_stats_rng(seed);
     if (!synthetic || !rng) {
         free(k);
         free(synthetic);
@@ -106,7 +114,6 @@ int bk_gr_gof(const double *m, size_t n, const bk_b_estimate *fit, size_t n_synt
             gsl_rng_free(rng);
         return BK_FAIL(err, BK_ERR_NOMEM, "out of memory for a bootstrap of %zu magnitudes", count);
     }
-    gsl_rng_set(rng, seed);
     double q = pow(10.0, -fit->b * fit->dm);
     out->n = count;
     out->d = bk_gr_distance(k, count, q);
@@ -114,7 +121,7 @@ int bk_gr_gof(const double *m, size_t n, const bk_b_estimate *fit, size_t n_synt
     size_t at_least = 0;
     for (size_t s = 0; s < n_synthetic; ++s) {
         for (size_t i = 0; i < count; ++i)
-            synthetic[i] = (long)floor(log(gsl_rng_uniform_pos(rng)) / log_q);
+            synthetic[i] = bk_stats_draw_offset(rng, log_q);
         double d = bk_gr_distance(synthetic, count, fitted_q(synthetic, count, fit->dm));
         at_least += d >= out->d;
     }
@@ -151,7 +158,7 @@ int bk_power_law_gof(const double *x, size_t n, const bk_power_law *fit, size_t 
     if (rc != BK_OK)
         return rc;
     double *above = malloc((n ? n : 1) * sizeof *above), *synthetic = malloc((n ? n : 1) * sizeof *synthetic);
-    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng *rng = bk_stats_rng(seed);
     if (!above || !synthetic || !rng) {
         free(above);
         free(synthetic);
@@ -170,7 +177,6 @@ int bk_power_law_gof(const double *x, size_t n, const bk_power_law *fit, size_t 
         return BK_FAIL(err, BK_ERR_INVALID, "%zu values at or above %g with exponent %g: a fit needs at least 2 "
                        "and an exponent > 1", count, fit->x_min, fit->alpha);
     }
-    gsl_rng_set(rng, seed);
     qsort(above, count, sizeof *above, compare_doubles);
     out->n = count;
     out->d = power_law_distance(above, count, fit->x_min, fit->alpha);
@@ -203,14 +209,13 @@ int bk_b_bootstrap(const double *m, size_t n, const bk_b_options *opt, size_t n_
     if (n < 2)
         return BK_FAIL(err, BK_ERR_INVALID, "%zu magnitudes: a bootstrap needs at least 2", n);
     double *resample = malloc(n * sizeof *resample);
-    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng *rng = bk_stats_rng(seed);
     if (!resample || !rng) {
         free(resample);
         if (rng)
             gsl_rng_free(rng);
         return BK_FAIL(err, BK_ERR_NOMEM, "out of memory for a bootstrap of %zu magnitudes", n);
     }
-    gsl_rng_set(rng, seed);
     /* Welford: the spread of the estimates without keeping them. */
     double b_mean = 0.0, b_m2 = 0.0, mc_mean = 0.0, mc_m2 = 0.0;
     size_t used = 0;

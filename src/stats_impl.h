@@ -2,7 +2,27 @@
 #ifndef BKSIM_STATS_IMPL_H
 #define BKSIM_STATS_IMPL_H
 
+#include <math.h>
 #include <stddef.h>
+
+#include <gsl/gsl_rng.h>
+
+/* x rounded to a multiple of dx, half-way up (SeismoStats' bin_to_precision: its decimal
+ * clean-up is the round trip through the bin index). */
+static inline double bk_stats_to_bin(double x, double dx)
+{
+    return floor(x / dx + 0.5 + 1e-12) * dx;
+}
+
+/* A bin offset k >= 0 of the binned GR law, P(K >= k) = q^k, drawn by inversion (log_q =
+ * ln q < 0). */
+static inline long bk_stats_draw_offset(gsl_rng *rng, double log_q)
+{
+    return (long)floor(log(gsl_rng_uniform_pos(rng)) / log_q);
+}
+
+/* GSL's MT19937 seeded: the generator of every bootstrap (NULL when out of memory). */
+gsl_rng *bk_stats_rng(unsigned long seed);
 
 /* The Kolmogorov-Smirnov distance between bin offsets k >= 0 (sorted here, in place) and the
  * binned Gutenberg-Richter law P(K <= k) = 1 - q^(k + 1), evaluated at the bin centres up to

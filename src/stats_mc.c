@@ -18,7 +18,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <gsl/gsl_rng.h>
 
 /* The length of numpy's arange(start, stop, step): ceil((stop - start) / step). */
 static size_t arange_length(double start, double stop, double step)
@@ -27,10 +26,6 @@ static size_t arange_length(double start, double stop, double step)
     return n > 0.0 ? (size_t)n : 0;
 }
 
-static double to_bin(double x, double dx)
-{
-    return floor(x / dx + 0.5 + 1e-12) * dx;
-}
 
 /* The smallest and largest of n >= 2 finite magnitudes that differ. */
 static int magnitude_range(const double *m, size_t n, const char *what, double *lo, double *hi, bk_error *err)
@@ -68,7 +63,7 @@ int bk_mc_b_stability(const double *m, size_t n, double dm, double range, bk_mc_
     out->range = range;
     out->steps = steps;
     for (size_t c = 0; c < n_candidates; ++c) {
-        double mc = to_bin(lo + (double)c * dm, dm);
+        double mc = bk_stats_to_bin(lo + (double)c * dm, dm);
         bk_b_estimate at;
         bk_error ignored = {0};
         if (bk_b_tinti(m, n, mc, dm, &at, &ignored) != BK_OK)
@@ -96,7 +91,7 @@ int bk_mc_b_stability(const double *m, size_t n, double dm, double range, bk_mc_
     return BK_FAIL(err, BK_ERR_INVALID,
                    "Mc by b-stability: none of the %zu candidates from %g up has a b-value within its error of the "
                    "mean over the next %g",
-                   out->n_tested, to_bin(lo, dm), range);
+                   out->n_tested, bk_stats_to_bin(lo, dm), range);
 }
 
 int bk_gr_ks_distance(const double *m, size_t n, double mc, double dm, double b, double *d, bk_error *err)
@@ -133,7 +128,7 @@ int bk_mc_ks(const double *m, size_t n, double dm, double p_pass, size_t n_synth
     if (status != BK_OK)
         return status;
     long *k = malloc(n * sizeof *k), *synthetic = malloc(n * sizeof *synthetic);
-    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng *rng = bk_stats_rng(seed);
     if (!k || !synthetic || !rng) {
         free(k);
         free(synthetic);
@@ -141,13 +136,12 @@ int bk_mc_ks(const double *m, size_t n, double dm, double p_pass, size_t n_synth
             gsl_rng_free(rng);
         return BK_FAIL(err, BK_ERR_NOMEM, "out of memory for %zu magnitudes", n);
     }
-    gsl_rng_set(rng, seed);
     size_t candidates = arange_length(lo, hi, dm);
     int rc = BK_FAIL(err, BK_ERR_INVALID,
                      "Mc by the KS method: no candidate from %g to %g passes (p >= %g against its own GR fit)",
-                     to_bin(lo, dm), to_bin(hi, dm), p_pass);
+                     bk_stats_to_bin(lo, dm), bk_stats_to_bin(hi, dm), p_pass);
     for (size_t c = 0; c < candidates; ++c) {
-        double mc = to_bin(lo + (double)c * dm, dm);
+        double mc = bk_stats_to_bin(lo + (double)c * dm, dm);
         bk_b_estimate fit;
         bk_error ignored = {0};
         if (bk_b_tinti(m, n, mc, dm, &fit, &ignored) != BK_OK)
@@ -159,10 +153,11 @@ int bk_mc_ks(const double *m, size_t n, double dm, double p_pass, size_t n_synth
         if (count < 2)
             continue;
         double q = pow(10.0, -fit.b * dm), d = bk_gr_distance(k, count, q);
+        double log_q = log(q);
         size_t at_least = 0;
         for (size_t s = 0; s < n_synthetic; ++s) {
             for (size_t i = 0; i < count; ++i)
-                synthetic[i] = (long)floor(log(gsl_rng_uniform_pos(rng)) / log(q));
+                synthetic[i] = bk_stats_draw_offset(rng, log_q);
             at_least += bk_gr_distance(synthetic, count, q) >= d;
         }
         out->n_tested = c + 1;

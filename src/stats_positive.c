@@ -7,6 +7,7 @@
  * seismostats/analysis/bvalue/positive.py, avalue/positive.py, bvalue/classic.py), so that
  * their published values are reproduced (tests/test_stats_positive.c). */
 #include "bksim/stats.h"
+#include "stats_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -14,12 +15,6 @@
 
 #define LN_10 2.30258509299404568402
 
-/* x rounded to a multiple of dx, half-way up (SeismoStats' bin_to_precision, whose decimal
- * clean-up the round-trip through the bin index gives here). */
-static double to_bin(double x, double dx)
-{
-    return floor(x / dx + 0.5 + 1e-12) * dx;
-}
 
 int bk_b_tinti(const double *m, size_t n, double mc, double dm, bk_b_estimate *out, bk_error *err)
 {
@@ -96,7 +91,7 @@ int bk_b_positive(const double *m, const double *t, size_t n, double mc, double 
     for (size_t i = 0; i + 1 < kept; ++i) {
         double d = ev[i + 1].m - ev[i].m;
         if (d >= dmc - 0.5 * dm) {
-            diff[count++] = to_bin(d, dm);
+            diff[count++] = bk_stats_to_bin(d, dm);
             dt_sum += ev[i + 1].t - ev[i].t;
         }
     }
