@@ -8,8 +8,11 @@
 #   output_rhs.tsv, output.md (scripts/bench_output.sh: what dense output costs),
 #   ruptures_bench.tsv (scripts/bench_ruptures.sh: the rupture catalog of a 10^6-block chain),
 #   rs_chains.tsv, rs_chains.png (scripts/bench_rs_chains.sh: CPU per rupture against N on a
-#   rate-and-state ring)
-# Takes about 30 minutes (the scaling part alone 19) on the machine in bench/machine.txt;
+#   rate-and-state ring), stats_convergence.tsv, .md, .png (scripts/bench_stats_convergence.sh:
+#   per back-end and rtol, the KS test of the Carlson-Langer ring's and lattice's rupture sizes
+#   against a converged reference, beside CPU)
+# Takes about 55 minutes (the scaling part alone 19, the statistics 25) on the machine in
+# bench/machine.txt;
 # `scripts/bench.sh --quick` is a smoke run into a temporary directory, `--plot-only`
 # redraws the PNGs and tables from the TSVs in bench/.
 # usage: scripts/bench.sh [--quick | --plot-only]
@@ -40,9 +43,11 @@ if [ $plot_only = 0 ]; then
     scripts/bench_output.sh $([ ${#quick[@]} -gt 0 ] && echo --quick) "$out"
     scripts/bench_ruptures.sh $([ ${#quick[@]} -gt 0 ] && echo --quick) "$out"
     scripts/bench_rs_chains.sh $([ ${#quick[@]} -gt 0 ] && echo --quick) "$out"
+    scripts/bench_stats_convergence.sh $([ ${#quick[@]} -gt 0 ] && echo --quick) "$out"
 fi
 if [ $plot_only = 1 ]; then scripts/bench_scaling.sh --plot-only "$out"; fi
 if [ $plot_only = 1 ] && [ -s "$out/rs_chains.tsv" ]; then scripts/bench_rs_chains.sh --plot-only "$out"; fi
+if [ $plot_only = 1 ] && [ -s "$out/stats_convergence.tsv" ]; then scripts/bench_stats_convergence.sh --plot-only "$out"; fi
 
 # Columns of results.tsv, by name.
 col() { awk -F'\t' -v name="$1" 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == name) print i; exit }' "$out/results.tsv"; }

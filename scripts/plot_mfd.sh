@@ -5,7 +5,11 @@
 #   OUTDIR/<stem>_ruptures_mfd.<fmt>  magnitude-frequency distribution: incremental (points)
 #       (events: <stem>_mfd.<fmt>)    and cumulative (line and points) counts per magnitude
 #                                     bin on a log scale, the fitted Gutenberg-Richter law
-#                                     log10 N = a - b M from Mc up, b and its error, Mc marked;
+#                                     log10 N = a - b M from Mc up, b and its error and the
+#                                     fit test's verdict (or why there is no b), Mc marked,
+#                                     and the GR law on the largest range [Mc, Mu] its fit
+#                                     test passes (fitted counts per bin; Mu marked): where a
+#                                     size cutoff bends the distribution, the law below it;
 #   OUTDIR/<stem>_ruptures_spacetime.<fmt>  every rupture's (event's) extent (blocks
 #       (events: <stem>_spacetime.<fmt>)    left..right) at its start time, coloured by
 #                                           magnitude; one that wraps past block 0 on a ring
@@ -69,13 +73,41 @@ left_out=""
 [ "$n_incomplete" -eq 0 ] || left_out="$n_incomplete still running at the end"
 [ "$n_nonfinite" -eq 0 ] || left_out="${left_out:+$left_out, }$n_nonfinite of zero potency (M = −∞)"
 subtitle="$n_events complete $rows_word in bins of ΔM = $dm${left_out:+; left out: $left_out}"
+# An object of the JSON report ("gr_fit", "gr_truncated") as one line, and a value in it.
+json_object() { { grep -o "\"$1\": {[^}]*}" "$tmp/stats.json" || true; } | head -n 1; }
+json_field() { grep -o "\"$2\": [^,}]*" <<< "$1" | head -n 1 | sed 's/^[^:]*: //'; }
+# Legend entries stay short enough for one line of the key (gnuplot drops a key wider than
+# the canvas): notes longer than that are cut.
+short() { local text=$1; [ ${#text} -le 95 ] && printf '%s' "$text" || printf '%s…' "${text:0:94}"; }
+gof=$(json_object gr_fit)
+verdict=""
+if [ -n "$gof" ]; then
+    verdict="KS distance $(num "$(json_field "$gof" ks_distance)" 3), bootstrap p = $(num "$(json_field "$gof" p_value)" 2 g)"
+fi
 if [ "$b" != null ]; then
     b_err_text=""
     [ "$b_err" = null ] || b_err_text=" ± $(num "$b_err" 3)"
-    fit_title="Gutenberg–Richter fit for M ≥ Mc: log₁₀ N = a − b M, b = $(num "$b" 3)${b_err_text}, a = $(num "$a" 3) ($n_mc $rows_word)"
-    fit_plot=", [x=$mc:$m_max + $dm/2] 10**($a - $b*x) with lines lw 2.5 lc rgb '#d62728' title '$fit_title'"
+    fit_title="GR fit for M ≥ Mc: log₁₀ N = a − b M, b = $(num "$b" 3)${b_err_text}, a = $(num "$a" 3) ($n_mc $rows_word)"
+    fit_plot=", [x=$mc:$m_max + $dm/2] 10**($a - $b*x) with lines lw 2.5 lc rgb '#d62728' title '$(bk_gp_quote "$fit_title")'"
+    [ -z "$verdict" ] ||
+        fit_plot+=", NaN with lines lw 0 lc rgb 'white' title '$(bk_gp_quote "   consistent with GR above Mc: $verdict")'"
+elif [ -n "$verdict" ] && [ "$(json_field "$gof" consistent)" = false ]; then
+    fit_plot=", NaN with lines lw 2.5 lc rgb '#d62728' title '$(bk_gp_quote "no b: not a Gutenberg–Richter distribution above Mc ($verdict)")'"
 else
-    fit_plot=", NaN with lines lw 2.5 lc rgb '#d62728' title 'no Gutenberg–Richter fit: $(bk_gp_quote "$(json_note b_value_note)")'"
+    fit_plot=", NaN with lines lw 2.5 lc rgb '#d62728' title '$(bk_gp_quote "$(short "no b: $(json_note b_value_note)")")'"
+fi
+# The truncated law (GR on [Mc, Mu], the largest range its fit test passes): fitted counts per
+# bin beside the incremental points, Mu marked.
+truncated=$(json_object gr_truncated)
+mu_arrow=""
+if [ -n "$truncated" ] && [ -s "$tmp/stats/gr_truncated_fit.tsv" ]; then
+    mu=$(json_field "$truncated" magnitude_max); n_above=$(json_field "$truncated" n_above)
+    t_title="GR on Mc ≤ M ≤ Mu = $(num "$mu" 6 g): b = $(num "$(json_field "$truncated" b_value)" 3) ± $(num "$(json_field "$truncated" b_value_error)" 3), p = $(num "$(json_field "$truncated" p_value)" 2 g), counts per bin"
+    [ "$n_above" = 0 ] || t_title+="; $n_above above Mu left out"
+    fit_plot+=", '$tmp/stats/gr_truncated_fit.tsv' using 1:2 with lines lw 2 dt 4 lc rgb '#2ca02c' title '$(bk_gp_quote "$t_title")'"
+    mu_arrow="set arrow 2 from $mu + $dm/2, graph 0 to $mu + $dm/2, graph 1 nohead dt 4 lw 1.5 lc rgb '#2ca02c' back"
+else
+    fit_plot+=", NaN with lines lw 2 dt 4 lc rgb '#2ca02c' title '$(bk_gp_quote "$(short "no truncated GR fit: $(json_note gr_truncated_note)")")'"
 fi
 mc_arrow=""; mc_plot=""
 if [ "$mc" != null ]; then
@@ -105,6 +137,7 @@ set yrange [0.5:$mfd_ymax]
 set mytics 10
 set key outside below center vertical Left reverse width -4 spacing 1.2
 $mc_arrow
+$mu_arrow
 plot '$tmp/stats/mfd.tsv' using 1:(\$3 > 0 ? \$3 : NaN) with linespoints pt 7 ps 0.9 lw 1.5 lc rgb '#1f77b4' title 'cumulative N(≥ M)', \
      '' using 1:(\$2 > 0 ? \$2 : NaN) with points pt 6 ps 1.3 lw 1.5 lc rgb '#ff7f0e' title 'incremental N(M), per bin' \
      $fit_plot $mc_plot

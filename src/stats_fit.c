@@ -57,17 +57,48 @@ static int compare_longs(const void *pa, const void *pb)
 
 /* The binned GR law above Mc is geometric in the bin offset: P(k) = (1 - q) q^k with
  * q = 10^(-b dm), CDF 1 - q^(k + 1) (stats_impl.h). */
-double bk_gr_distance(long *k, size_t n, double q)
+double bk_gr_distance_counts(const size_t *count, long top, size_t n, double q)
 {
-    qsort(k, n, sizeof *k, compare_longs);
+    double d = 0.0;
+    size_t below = 0;
+    for (long bin = 0; bin <= top; ++bin) {
+        below += count[bin];
+        double empirical = (double)below / (double)n, model = 1.0 - pow(q, (double)(bin + 1));
+        d = fmax(d, fabs(empirical - model));
+    }
+    return d;
+}
+
+/* The empirical CDF comes from a count per offset (offsets span a few dozen bins): sorting
+ * every synthetic sample of a bootstrap cost most of a long catalog's report.  A span too
+ * long to count falls back to sorting a copy. */
+double bk_gr_distance(const long *k, size_t n, double q)
+{
+    long top = 0;
+    for (size_t i = 0; i < n; ++i)
+        top = k[i] > top ? k[i] : top;
+    size_t *count = (size_t)top < 16 * n + 1024 ? calloc((size_t)top + 1, sizeof *count) : NULL;
+    if (count) {
+        for (size_t i = 0; i < n; ++i)
+            ++count[k[i]];
+        double d = bk_gr_distance_counts(count, top, n, q);
+        free(count);
+        return d;
+    }
+    long *sorted = malloc((n ? n : 1) * sizeof *sorted);
+    if (!sorted)
+        return NAN;
+    memcpy(sorted, k, n * sizeof *sorted);
+    qsort(sorted, n, sizeof *sorted, compare_longs);
     double d = 0.0;
     size_t i = 0;
     for (long bin = 0; i < n; ++bin) {
-        while (i < n && k[i] <= bin)
+        while (i < n && sorted[i] <= bin)
             ++i;
         double empirical = (double)i / (double)n, model = 1.0 - pow(q, (double)(bin + 1));
         d = fmax(d, fabs(empirical - model));
     }
+    free(sorted);
     return d;
 }
 

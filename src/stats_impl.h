@@ -24,9 +24,11 @@ static inline long bk_stats_draw_offset(gsl_rng *rng, double log_q)
 /* GSL's MT19937 seeded: the generator of every bootstrap (NULL when out of memory). */
 gsl_rng *bk_stats_rng(unsigned long seed);
 
-/* The Kolmogorov-Smirnov distance between bin offsets k >= 0 (sorted here, in place) and the
+/* The Kolmogorov-Smirnov distance between bin offsets k >= 0 (n >= 1, not modified) and the
  * binned Gutenberg-Richter law P(K <= k) = 1 - q^(k + 1), evaluated at the bin centres up to
- * the largest offset (as SeismoStats' ks_test_gr; src/stats_fit.c). */
-double bk_gr_distance(long *k, size_t n, double q);
+ * the largest offset (as SeismoStats' ks_test_gr; src/stats_fit.c); NaN when out of memory. */
+double bk_gr_distance(const long *k, size_t n, double q);
+/* The same distance from count[j], the offsets equal to j, j = 0..top (n in all). */
+double bk_gr_distance_counts(const size_t *count, long top, size_t n, double q);
 
 #endif

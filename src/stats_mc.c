@@ -10,14 +10,41 @@
  * it are at most as far from their GR fit (bk_b_tinti's b) as synthetic GR samples of the
  * same size and b are from that law in a fraction p_pass of cases (0.1 by default); the
  * synthetic samples, unlike bk_gr_gof's, are not refitted, as in SeismoStats, and come from
- * a seeded MT19937 where SeismoStats' come from numpy's unseeded generator. */
+ * a seeded MT19937 where SeismoStats' come from numpy's unseeded generator, drawn as counts
+ * per bin (the same law, in O(bins) draws per sample). */
 #include "bksim/stats.h"
 #include "stats_impl.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include <gsl/gsl_randist.h>
+
+
+/* A sample of n offsets of the geometric law P(k) = (1 - q) q^k as counts per offset: the
+ * law is memoryless, so of the m offsets >= j, Binomial(m, 1 - q) equal j.  O(bins) draws
+ * where drawing each offset is O(n) logarithms: the KS method tests every candidate with
+ * thousands of samples.  *count grows as needed (*cap entries); returns the largest offset
+ * drawn, or -1 when out of memory. */
+static long draw_counts(gsl_rng *rng, size_t n, double q, size_t **count, size_t *cap)
+{
+    long top = -1;
+    for (size_t left = n; left > 0;) {
+        if ((size_t)(top + 1) == *cap) {
+            size_t *grown = realloc(*count, 2 * *cap * sizeof *grown);
+            if (!grown)
+                return -1;
+            *count = grown;
+            *cap *= 2;
+        }
+        unsigned here = gsl_ran_binomial(rng, 1.0 - q, (unsigned)left);
+        (*count)[++top] = here;
+        left -= here;
+    }
+    return top;
+}
 
 /* The length of numpy's arange(start, stop, step): ceil((stop - start) / step). */
 static size_t arange_length(double start, double stop, double step)
@@ -127,7 +154,11 @@ int bk_mc_ks(const double *m, size_t n, double dm, double p_pass, size_t n_synth
     int status = magnitude_range(m, n, "Mc by the KS method", &lo, &hi, err);
     if (status != BK_OK)
         return status;
-    long *k = malloc(n * sizeof *k), *synthetic = malloc(n * sizeof *synthetic);
+    if (n > UINT_MAX)
+        return BK_FAIL(err, BK_ERR_INVALID, "Mc by the KS method: %zu magnitudes: at most %u", n, UINT_MAX);
+    size_t cap = 64;
+    long *k = malloc(n * sizeof *k);
+    size_t *synthetic = malloc(cap * sizeof *synthetic);
     gsl_rng *rng = bk_stats_rng(seed);
     if (!k || !synthetic || !rng) {
         free(k);
@@ -153,12 +184,17 @@ int bk_mc_ks(const double *m, size_t n, double dm, double p_pass, size_t n_synth
         if (count < 2)
             continue;
         double q = pow(10.0, -fit.b * dm), d = bk_gr_distance(k, count, q);
-        double log_q = log(q);
+        /* A slope this flat spreads a sample over ~1e9 bins: no law to test against. */
+        if (!(q < 1.0 - 1e-9))
+            continue;
         size_t at_least = 0;
         for (size_t s = 0; s < n_synthetic; ++s) {
-            for (size_t i = 0; i < count; ++i)
-                synthetic[i] = bk_stats_draw_offset(rng, log_q);
-            at_least += bk_gr_distance(synthetic, count, q) >= d;
+            long top = draw_counts(rng, count, q, &synthetic, &cap);
+            if (top < 0) {
+                rc = BK_FAIL(err, BK_ERR_NOMEM, "Mc by the KS method: out of memory for a synthetic sample");
+                goto done;
+            }
+            at_least += bk_gr_distance_counts(synthetic, top, count, q) >= d;
         }
         out->n_tested = c + 1;
         out->mc = mc;
@@ -172,6 +208,7 @@ int bk_mc_ks(const double *m, size_t n, double dm, double p_pass, size_t n_synth
             break;
         }
     }
+done:
     free(k);
     free(synthetic);
     gsl_rng_free(rng);

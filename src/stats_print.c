@@ -1,6 +1,8 @@
 /* `bksim stats`: the report of src/stats_report.c presented as text, one JSON object, or
  * TSV tables for gnuplot. */
 #include "bksim/stats.h"
+#include "bksim/stats_truncated.h"
+#include "stats_print_impl.h"
 
 #include <errno.h>
 #include <math.h>
@@ -11,25 +13,12 @@
 
 /* ------------------------------------------------------------------ text --- */
 
-static int write_failed(FILE *out, const char *what, bk_error *err)
-{
-    if (ferror(out))
-        return BK_FAIL(err, BK_ERR_IO, "writing the %s failed: %s", what, strerror(errno));
-    return BK_OK;
-}
-
 int bk_stats_report_text(const bk_stats_report *r, FILE *out, bk_error *err)
 {
     const bk_stats_options *o = &r->options;
     fprintf(out, "catalog: %s\n", r->path);
     /* Which table: the default /ruptures, the /events it falls back to, or one named. */
-    const char *what = "";
-    if (r->table && r->table_fallback)
-        what = " (the time-window catalog: the file has no /ruptures)";
-    else if (r->table && strcmp(r->table, "ruptures") == 0)
-        what = " (the rupture catalog)";
-    else if (r->table && strcmp(r->table, "events") == 0)
-        what = " (the time-window catalog)";
+    const char *what = bk_stats_table_note(r->table, r->table_fallback);
     fprintf(out, "  %s%s%s: %zu rows; fields beyond t_start, magnitude:%s%s%s%s%s\n",
             r->table ? "/" : "", r->table ? r->table : "table", what, r->n_rows,
             r->has_t_end ? " t_end" : "", r->has_potency ? " potency" : "",
@@ -94,6 +83,21 @@ int bk_stats_report_text(const bk_stats_report *r, FILE *out, bk_error *err)
                      "synthetic samples, refitted)\n",
                 r->gr_gof.p < BK_GOF_LEVEL ? "not" : "consistent with", r->gr_gof.d, r->gr_gof.p,
                 r->gr_gof.n_synthetic);
+    if (r->truncation) {
+        const bk_gr_truncation *tr = r->truncation;
+        const bk_b_truncated_estimate *f = &tr->fit;
+        fprintf(out, "truncated GR (Mc to the largest Mu whose range passes the fit test; Weichert 1980, binned): "
+                     "%.4f +- %.4f over M %.6g to %.6g, %zu events",
+                f->b, f->sigma, f->mc, f->mu, f->n);
+        if (f->n_above)
+            fprintf(out, "; %zu above Mu (up to %.6g) left out: a size cutoff", f->n_above, tr->m_top);
+        else
+            fprintf(out, "; the whole range (no cutoff)");
+        fprintf(out, "\n  fit: KS distance %.4f, deviance %.4g, p = %.3g (%zu synthetic samples, refitted)\n",
+                tr->gof.d, tr->gof.g, tr->gof.p, tr->gof.n_synthetic);
+    } else if (r->have_mc) {
+        fprintf(out, "truncated GR: not available: %s\n", r->truncation_note);
+    }
     if (r->have_b_positive) {
         const bk_b_positive_estimate *bp = &r->b_positive;
         fprintf(out, "b-positive (van der Elst 2021; differences of successive magnitudes >= %g, binned "
@@ -111,6 +115,12 @@ int bk_stats_report_text(const bk_stats_report *r, FILE *out, bk_error *err)
                 r->mc_stability.mc, r->mc_stability.b, r->mc_stability.diff);
     else if (r->have_mfd)
         fprintf(out, "Mc by b-value stability: not available: %s\n", r->mc_stability_note);
+    if (r->have_mc_ks)
+        fprintf(out, "Mc by the KS method (first magnitude whose GR fit passes at p >= %g, %zu synthetic samples): %.6g "
+                     "(b = %.4f, KS distance %.4f, p = %.3g, %zu events)\n",
+                BK_MC_KS_P_PASS, r->options.bootstrap, r->mc_ks.mc, r->mc_ks.b, r->mc_ks.d, r->mc_ks.p, r->mc_ks.n);
+    else if (r->have_mfd)
+        fprintf(out, "Mc by the KS method: not available: %s\n", r->mc_ks_note);
     if (r->have_potency_exponent) {
         const bk_power_law *p = &r->potency_fit;
         fprintf(out, "potency exponent: alpha = %.4f +- %.4f over %zu events with P >= %.6g m "
@@ -150,6 +160,8 @@ int bk_stats_report_text(const bk_stats_report *r, FILE *out, bk_error *err)
     } else {
         fprintf(out, "interevent times: not available: %s\n", r->interevent_note);
     }
+    bk_stats_text_sequences(r, out);
+    bk_stats_text_scaling(r, out);
     if (r->have_sizes)
         fprintf(out, "sizes: %zu complete events, 1 to %d blocks, mean %.4g\n", r->sizes.n_events,
                 (int)r->sizes.max_size, r->sizes.mean);
@@ -169,184 +181,151 @@ int bk_stats_report_text(const bk_stats_report *r, FILE *out, bk_error *err)
             fprintf(out, "  %9.4g %12zu %12zu\n", bk_mfd_centre(&r->mfd, i),
                     r->mfd.incremental[i], r->mfd.cumulative[i]);
     }
-    return write_failed(out, "report", err);
+    return bk_stats_write_failed(out, "report", err);
 }
 
 /* ------------------------------------------------------------------ JSON --- */
-
-/* The shortest text that reads back as the same double (0.1, not 0.10000000000000001);
- * JSON has no NaN or infinity: null. */
-static void json_number(FILE *out, const char *key, double value, int last)
-{
-    char text[32] = "null";
-    if (isfinite(value))
-        for (int digits = 15; digits <= 17; ++digits) {
-            snprintf(text, sizeof text, "%.*g", digits, value);
-            if (strtod(text, NULL) == value)
-                break;
-        }
-    fprintf(out, "\"%s\": %s%s", key, text, last ? "" : ", ");
-}
-
-static void json_count(FILE *out, const char *key, size_t value)
-{
-    fprintf(out, "\"%s\": %zu, ", key, value);
-}
-
-static void json_string_value(FILE *out, const char *s)
-{
-    fputc('"', out);
-    for (const unsigned char *p = (const unsigned char *)s; *p; ++p) {
-        if (*p == '"' || *p == '\\')
-            fprintf(out, "\\%c", *p);
-        else if (*p < 0x20)
-            fprintf(out, "\\u%04x", *p);
-        else
-            fputc(*p, out);
-    }
-    fputc('"', out);
-}
-
-static void json_note(FILE *out, const char *key, int have, const char *note)
-{
-    if (have)
-        return;
-    fprintf(out, "\"%s\": ", key);
-    json_string_value(out, note);
-    fprintf(out, ", ");
-}
-
-/* "key": {"n": .., "ks_distance": .., "p_value": .., "synthetic_samples": .., "consistent": ..}
- * or null when the fit was not tested. */
-static void json_gof(FILE *out, const char *key, int have, const bk_gof *g)
-{
-    fprintf(out, "\"%s\": ", key);
-    if (!have) {
-        fprintf(out, "null, ");
-        return;
-    }
-    fprintf(out, "{\"n\": %zu, ", g->n);
-    json_number(out, "ks_distance", g->d, 0);
-    json_number(out, "p_value", g->p, 0);
-    fprintf(out, "\"synthetic_samples\": %zu, \"consistent\": %s}, ", g->n_synthetic,
-            g->p < BK_GOF_LEVEL ? "false" : "true");
-}
 
 int bk_stats_report_json(const bk_stats_report *r, FILE *out, bk_error *err)
 {
     const double absent = NAN;
     fprintf(out, "{\"file\": ");
-    json_string_value(out, r->path);
+    bk_json_string(out, r->path);
     fprintf(out, ", \"table\": ");
     if (r->table)
-        json_string_value(out, r->table);
+        bk_json_string(out, r->table);
     else
         fprintf(out, "null");
     fprintf(out, ", \"table_fallback\": %s, ", r->table_fallback ? "true" : "false");
-    json_count(out, "n_rows", r->n_rows);
-    json_count(out, "n_incomplete", r->n_incomplete);
-    json_count(out, "n_nonfinite", r->n_nonfinite);
-    json_number(out, "t_from", r->options.t_from, 0);
-    json_number(out, "t_to", r->options.t_to, 0);
-    json_count(out, "n_outside_window", r->n_outside);
-    json_count(out, "n_events", r->n_events);
-    json_number(out, "duration", r->n_events ? r->duration : absent, 0);
+    bk_json_count(out, "n_rows", r->n_rows);
+    bk_json_count(out, "n_incomplete", r->n_incomplete);
+    bk_json_count(out, "n_nonfinite", r->n_nonfinite);
+    bk_json_number(out, "t_from", r->options.t_from, 0);
+    bk_json_number(out, "t_to", r->options.t_to, 0);
+    bk_json_count(out, "n_outside_window", r->n_outside);
+    bk_json_count(out, "n_events", r->n_events);
+    bk_json_number(out, "duration", r->n_events ? r->duration : absent, 0);
     fprintf(out, "\"duration_source\": \"%s\", ", r->duration_from_run ? "run" : "catalog");
-    json_number(out, "rate", r->n_events ? r->rate : absent, 0);
-    json_number(out, "magnitude_min", r->n_events ? r->m_min : absent, 0);
-    json_number(out, "magnitude_max", r->n_events ? r->m_max : absent, 0);
-    json_number(out, "bin", r->options.dm, 0);
-    json_number(out, "mc", r->have_mc ? r->mc : absent, 0);
+    bk_json_number(out, "rate", r->n_events ? r->rate : absent, 0);
+    bk_json_number(out, "magnitude_min", r->n_events ? r->m_min : absent, 0);
+    bk_json_number(out, "magnitude_max", r->n_events ? r->m_max : absent, 0);
+    bk_json_number(out, "bin", r->options.dm, 0);
+    bk_json_number(out, "mc", r->have_mc ? r->mc : absent, 0);
     fprintf(out, "\"mc_method\": \"%s\", ", r->options.mc_auto ? "maxc" : "given");
-    json_number(out, "mc_correction", r->options.mc_auto ? r->options.mc_correction : absent, 0);
-    json_count(out, "n_above_mc", r->n_above_mc);
-    json_number(out, "rate_above_mc", r->have_mc ? r->rate_above_mc : absent, 0);
-    json_number(out, "b_value", r->have_b ? r->b.b : absent, 0);
-    json_number(out, "b_value_error", r->have_b ? r->b.sigma : absent, 0);
-    json_number(out, "b_value_error_aki", r->have_b ? r->b.sigma_aki : absent, 0);
-    json_number(out, "a_value", r->have_b ? r->b.a : absent, 0);
-    json_number(out, "mean_magnitude_above_mc", r->have_b ? r->b.mean : absent, 0);
-    json_note(out, "b_value_note", r->have_b, r->b_note);
+    bk_json_number(out, "mc_correction", r->options.mc_auto ? r->options.mc_correction : absent, 0);
+    bk_json_count(out, "n_above_mc", r->n_above_mc);
+    bk_json_number(out, "rate_above_mc", r->have_mc ? r->rate_above_mc : absent, 0);
+    bk_json_number(out, "b_value", r->have_b ? r->b.b : absent, 0);
+    bk_json_number(out, "b_value_error", r->have_b ? r->b.sigma : absent, 0);
+    bk_json_number(out, "b_value_error_aki", r->have_b ? r->b.sigma_aki : absent, 0);
+    bk_json_number(out, "a_value", r->have_b ? r->b.a : absent, 0);
+    bk_json_number(out, "mean_magnitude_above_mc", r->have_b ? r->b.mean : absent, 0);
+    bk_json_note(out, "b_value_note", r->have_b, r->b_note);
     fprintf(out, "\"n_b_value\": %zu, \"b_value_small_sample\": %s, ", r->have_b ? r->b.n : 0,
             r->have_b && r->b_small_sample ? "true" : "false");
-    json_number(out, "b_value_error_bootstrap", r->have_b_spread ? r->b_spread.b_sigma : absent, 0);
-    json_number(out, "mc_error_bootstrap", r->have_b_spread ? r->b_spread.mc_sigma : absent, 0);
+    bk_json_number(out, "b_value_error_bootstrap", r->have_b_spread ? r->b_spread.b_sigma : absent, 0);
+    bk_json_number(out, "mc_error_bootstrap", r->have_b_spread ? r->b_spread.mc_sigma : absent, 0);
     fprintf(out, "\"bootstrap_resamples\": %zu, ", r->have_b_spread ? r->b_spread.n_used : 0);
-    json_gof(out, "gr_fit", r->have_gr_gof, &r->gr_gof);
-    json_number(out, "b_positive", r->have_b_positive ? r->b_positive.fit.b : absent, 0);
-    json_number(out, "b_positive_error", r->have_b_positive ? r->b_positive.fit.sigma : absent, 0);
+    bk_json_gof(out, "gr_fit", r->have_gr_gof, &r->gr_gof);
+    fprintf(out, "\"gr_truncated\": ");
+    if (r->truncation) {
+        const bk_gr_truncation *tr = r->truncation;
+        fprintf(out, "{");
+        bk_json_number(out, "b_value", tr->fit.b, 0);
+        bk_json_number(out, "b_value_error", tr->fit.sigma, 0);
+        bk_json_number(out, "magnitude_min", tr->fit.mc, 0);
+        bk_json_number(out, "magnitude_max", tr->fit.mu, 0);
+        bk_json_number(out, "magnitude_top", tr->m_top, 0);
+        bk_json_count(out, "n", tr->fit.n);
+        bk_json_count(out, "n_above", tr->fit.n_above);
+        bk_json_number(out, "a_bin", tr->fit.a_bin, 0);
+        bk_json_number(out, "ks_distance", tr->gof.d, 0);
+        bk_json_number(out, "deviance", tr->gof.g, 0);
+        bk_json_number(out, "p_value", tr->gof.p, 0);
+        fprintf(out, "\"synthetic_samples\": %zu}, ", tr->gof.n_synthetic);
+    } else {
+        fprintf(out, "null, ");
+        bk_json_note(out, "gr_truncated_note", 0, r->have_mc ? r->truncation_note : "no Mc");
+    }
+    bk_json_number(out, "b_positive", r->have_b_positive ? r->b_positive.fit.b : absent, 0);
+    bk_json_number(out, "b_positive_error", r->have_b_positive ? r->b_positive.fit.sigma : absent, 0);
     fprintf(out, "\"n_b_positive\": %zu, ", r->have_b_positive ? r->b_positive.fit.n : 0);
-    json_number(out, "a_positive", r->have_b_positive ? r->b_positive.a : absent, 0);
-    json_note(out, "b_positive_note", r->have_b_positive || !r->have_mc, r->b_positive_note);
-    json_number(out, "mc_b_stability", r->have_mc_stability ? r->mc_stability.mc : absent, 0);
-    json_note(out, "mc_b_stability_note", r->have_mc_stability || !r->have_mfd, r->mc_stability_note);
+    bk_json_number(out, "a_positive", r->have_b_positive ? r->b_positive.a : absent, 0);
+    bk_json_note(out, "b_positive_note", r->have_b_positive || !r->have_mc, r->b_positive_note);
+    bk_json_number(out, "mc_b_stability", r->have_mc_stability ? r->mc_stability.mc : absent, 0);
+    bk_json_note(out, "mc_b_stability_note", r->have_mc_stability || !r->have_mfd, r->mc_stability_note);
+    bk_json_number(out, "mc_ks", r->have_mc_ks ? r->mc_ks.mc : absent, 0);
+    bk_json_number(out, "mc_ks_p", r->have_mc_ks ? r->mc_ks.p : absent, 0);
+    bk_json_note(out, "mc_ks_note", r->have_mc_ks || !r->have_mfd, r->mc_ks_note);
     const bk_power_law *p = &r->potency_fit;
     int hp = r->have_potency_exponent;
-    json_number(out, "potency_exponent", hp ? p->alpha : absent, 0);
-    json_number(out, "potency_exponent_error", hp ? p->sigma : absent, 0);
-    json_number(out, "potency_min", hp ? p->x_min : absent, 0);
+    bk_json_number(out, "potency_exponent", hp ? p->alpha : absent, 0);
+    bk_json_number(out, "potency_exponent_error", hp ? p->sigma : absent, 0);
+    bk_json_number(out, "potency_min", hp ? p->x_min : absent, 0);
     fprintf(out, "\"n_potency\": %zu, ", hp ? p->n : 0);
-    json_note(out, "potency_note", hp, r->potency_note);
-    json_gof(out, "potency_fit", r->have_potency_gof, &r->potency_gof);
+    bk_json_note(out, "potency_note", hp, r->potency_note);
+    bk_json_gof(out, "potency_fit", r->have_potency_gof, &r->potency_gof);
     const bk_recurrence *rec = &r->recurrence;
     int hr = r->have_recurrence;
     fprintf(out, "\"recurrence\": ");
     if (hr) {
         fprintf(out, "{");
-        json_number(out, "magnitude_min", rec->m_min, 0);
-        json_count(out, "n_events", rec->n_events);
-        json_number(out, "mean_interval", rec->mean, 0);
-        json_number(out, "sd_interval", rec->sd, 0);
-        json_number(out, "cv", rec->cv, 1);
+        bk_json_number(out, "magnitude_min", rec->m_min, 0);
+        bk_json_count(out, "n_events", rec->n_events);
+        bk_json_number(out, "mean_interval", rec->mean, 0);
+        bk_json_number(out, "sd_interval", rec->sd, 0);
+        bk_json_number(out, "cv", rec->cv, 1);
         fprintf(out, "}, ");
     } else {
         fprintf(out, "null, ");
     }
-    json_note(out, "recurrence_note", hr, r->recurrence_note);
+    bk_json_note(out, "recurrence_note", hr, r->recurrence_note);
     fprintf(out, "\"interevent\": [");
     for (size_t k = 0; k < r->n_interevent; ++k) {
         const bk_interevent *ie = &r->interevent[k];
         fprintf(out, "%s{", k ? ", " : "");
-        json_number(out, "magnitude_min", ie->m_min, 0);
-        json_count(out, "n_events", ie->n_events);
-        json_number(out, "rate", ie->rate, 0);
-        json_number(out, "cv", ie->cv, 0);
-        json_count(out, "zero_intervals", ie->n_zero);
-        json_number(out, "gamma_shape", ie->gamma_shape, 0);
-        json_number(out, "gamma_shape_error", ie->gamma_shape_sigma, 0);
-        json_number(out, "gamma_scale", ie->gamma_scale, 1);
+        bk_json_number(out, "magnitude_min", ie->m_min, 0);
+        bk_json_count(out, "n_events", ie->n_events);
+        bk_json_number(out, "rate", ie->rate, 0);
+        bk_json_number(out, "cv", ie->cv, 0);
+        bk_json_count(out, "zero_intervals", ie->n_zero);
+        bk_json_number(out, "gamma_shape", ie->gamma_shape, 0);
+        bk_json_number(out, "gamma_shape_error", ie->gamma_shape_sigma, 0);
+        bk_json_number(out, "gamma_scale", ie->gamma_scale, 1);
         fprintf(out, "}");
     }
     fprintf(out, "], ");
     if (r->n_interevent == 0) {
         fprintf(out, "\"interevent_note\": ");
-        json_string_value(out, r->interevent_note);
+        bk_json_string(out, r->interevent_note);
         fprintf(out, ", ");
     }
+    bk_stats_json_sequences(r, out);
+    bk_stats_json_scaling(r, out);
     fprintf(out, "\"sizes\": ");
     if (r->have_sizes) {
         fprintf(out, "{");
-        json_count(out, "n_events", r->sizes.n_events);
+        bk_json_count(out, "n_events", r->sizes.n_events);
         fprintf(out, "\"max\": %d, ", (int)r->sizes.max_size);
-        json_number(out, "mean", r->sizes.mean, 1);
+        bk_json_number(out, "mean", r->sizes.mean, 1);
         fprintf(out, "}, ");
     } else {
         fprintf(out, "null, ");
     }
-    json_note(out, "sizes_note", r->have_sizes, r->sizes_note);
+    bk_json_note(out, "sizes_note", r->have_sizes, r->sizes_note);
     fprintf(out, "\"ks_halves\": ");
     if (r->have_ks) {
         fprintf(out, "{");
-        json_number(out, "t_split", r->ks_t_split, 0);
-        json_count(out, "n1", r->ks.n1);
-        json_count(out, "n2", r->ks.n2);
-        json_number(out, "d", r->ks.d, 0);
-        json_number(out, "p", r->ks.p, 1);
+        bk_json_number(out, "t_split", r->ks_t_split, 0);
+        bk_json_count(out, "n1", r->ks.n1);
+        bk_json_count(out, "n2", r->ks.n2);
+        bk_json_number(out, "d", r->ks.d, 0);
+        bk_json_number(out, "p", r->ks.p, 1);
         fprintf(out, "}, ");
     } else {
         fprintf(out, "null, ");
     }
-    json_note(out, "ks_note", r->have_ks, r->ks_note);
+    bk_json_note(out, "ks_note", r->have_ks, r->ks_note);
     fprintf(out, "\"mfd\": ");
     if (r->have_mfd) {
         const char *cols[] = {"magnitude", "incremental", "cumulative"};
@@ -368,35 +347,10 @@ int bk_stats_report_json(const bk_stats_report *r, FILE *out, bk_error *err)
         fprintf(out, "null");
     }
     fprintf(out, "}\n");
-    return write_failed(out, "JSON report", err);
+    return bk_stats_write_failed(out, "JSON report", err);
 }
 
 /* ------------------------------------------------------------------- TSV --- */
-
-static FILE *open_table(const char *dir, const char *name, char *path, size_t len,
-                        const char *header, bk_error *err)
-{
-    int w = snprintf(path, len, "%s/%s", dir, name);
-    if (w < 0 || (size_t)w >= len) {
-        BK_FAIL(err, BK_ERR_IO, "%s/%s: path too long", dir, name);
-        return NULL;
-    }
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        BK_FAIL(err, BK_ERR_IO, "%s: %s", path, strerror(errno));
-        return NULL;
-    }
-    fprintf(f, "%s\n", header);
-    return f;
-}
-
-static int close_table(FILE *f, const char *path, bk_error *err)
-{
-    int bad = ferror(f);
-    if (fclose(f) != 0 || bad)
-        return BK_FAIL(err, BK_ERR_IO, "%s: write failed: %s", path, strerror(errno));
-    return BK_OK;
-}
 
 static int compare_desc(const void *pa, const void *pb)
 {
@@ -415,7 +369,7 @@ static int potency_table(const bk_stats_report *r, const char *dir, char *path, 
         if (isfinite(r->potency[i]) && r->potency[i] > 0.0)
             p[n++] = r->potency[i];
     qsort(p, n, sizeof *p, compare_desc);
-    FILE *f = open_table(dir, "potency_ccdf.tsv", path, len, "# potency[m]\tn_at_or_above[1]", err);
+    FILE *f = bk_stats_open_table(dir, "potency_ccdf.tsv", path, len, "# potency[m]\tn_at_or_above[1]", err);
     if (!f) {
         free(p);
         return err ? err->status : BK_ERR_IO;
@@ -425,7 +379,7 @@ static int potency_table(const bk_stats_report *r, const char *dir, char *path, 
         if (i + 1 == n || p[i + 1] != p[i])
             fprintf(f, "%.10g\t%zu\n", p[i], i + 1);
     free(p);
-    return close_table(f, path, err);
+    return bk_stats_close_table(f, path, err);
 }
 
 int bk_stats_report_tsv(const bk_stats_report *r, const char *dir, bk_error *err)
@@ -442,18 +396,18 @@ int bk_stats_report_tsv(const bk_stats_report *r, const char *dir, bk_error *err
     FILE *f;
     int rc;
     if (r->have_mfd) {
-        if (!(f = open_table(dir, "mfd.tsv", path, sizeof path,
+        if (!(f = bk_stats_open_table(dir, "mfd.tsv", path, sizeof path,
                              "# magnitude[1]\tincremental[1]\tcumulative[1]", err)))
             return err ? err->status : BK_ERR_IO;
         for (size_t i = 0; i < r->mfd.n_bins; ++i)
             fprintf(f, "%.10g\t%zu\t%zu\n", bk_mfd_centre(&r->mfd, i), r->mfd.incremental[i],
                     r->mfd.cumulative[i]);
-        if ((rc = close_table(f, path, err)) != BK_OK)
+        if ((rc = bk_stats_close_table(f, path, err)) != BK_OK)
             return rc;
     }
     if (r->have_b) {
         /* The fitted law N(>= M) = 10^(a - b M) at the bin centres from Mc up. */
-        if (!(f = open_table(dir, "gr_fit.tsv", path, sizeof path,
+        if (!(f = bk_stats_open_table(dir, "gr_fit.tsv", path, sizeof path,
                              "# magnitude[1]\tcumulative_fit[1]", err)))
             return err ? err->status : BK_ERR_IO;
         for (size_t i = 0; i < r->mfd.n_bins; ++i) {
@@ -461,18 +415,31 @@ int bk_stats_report_tsv(const bk_stats_report *r, const char *dir, bk_error *err
             if (m >= r->mc - 0.5 * r->options.dm)
                 fprintf(f, "%.10g\t%.10g\n", m, pow(10.0, r->b.a - r->b.b * m));
         }
-        if ((rc = close_table(f, path, err)) != BK_OK)
+        if ((rc = bk_stats_close_table(f, path, err)) != BK_OK)
+            return rc;
+    }
+    if (r->truncation) {
+        /* The fitted count per bin from Mc to Mu, 10^(a_bin - b M), beside mfd.tsv's incremental counts. */
+        const bk_b_truncated_estimate *t = &r->truncation->fit;
+        if (!(f = bk_stats_open_table(dir, "gr_truncated_fit.tsv", path, sizeof path,
+                                      "# magnitude[1]\tincremental_fit[1]", err)))
+            return err ? err->status : BK_ERR_IO;
+        for (size_t j = 0; j < t->n_bins; ++j) {
+            double m = t->mc + (double)j * t->dm;
+            fprintf(f, "%.10g\t%.10g\n", m, pow(10.0, t->a_bin - t->b * m));
+        }
+        if ((rc = bk_stats_close_table(f, path, err)) != BK_OK)
             return rc;
     }
     if (r->have_sizes) {
-        if (!(f = open_table(dir, "sizes.tsv", path, sizeof path, "# n_blocks[1]\tcount[1]", err)))
+        if (!(f = bk_stats_open_table(dir, "sizes.tsv", path, sizeof path, "# n_blocks[1]\tcount[1]", err)))
             return err ? err->status : BK_ERR_IO;
         for (int32_t s = 1; s <= r->sizes.max_size; ++s)
             if (r->sizes.count[s])
                 fprintf(f, "%d\t%zu\n", (int)s, r->sizes.count[s]);
-        if ((rc = close_table(f, path, err)) != BK_OK)
+        if ((rc = bk_stats_close_table(f, path, err)) != BK_OK)
             return rc;
-        if (!(f = open_table(dir, "sizes_log2.tsv", path, sizeof path,
+        if (!(f = bk_stats_open_table(dir, "sizes_log2.tsv", path, sizeof path,
                              "# n_blocks_min[1]\tn_blocks_max[1]\tcount[1]\tcount_per_size[1]",
                              err)))
             return err ? err->status : BK_ERR_IO;
@@ -481,21 +448,21 @@ int bk_stats_report_tsv(const bk_stats_report *r, const char *dir, bk_error *err
             fprintf(f, "%.0f\t%.0f\t%zu\t%.10g\n", lo, hi, r->sizes.log2_count[j],
                     (double)r->sizes.log2_count[j] / lo);
         }
-        if ((rc = close_table(f, path, err)) != BK_OK)
+        if ((rc = bk_stats_close_table(f, path, err)) != BK_OK)
             return rc;
     }
     if (r->have_recurrence) {
-        if (!(f = open_table(dir, "intervals.tsv", path, sizeof path,
+        if (!(f = bk_stats_open_table(dir, "intervals.tsv", path, sizeof path,
                              "# t_start[s]\tinterval[s]", err)))
             return err ? err->status : BK_ERR_IO;
         for (size_t i = 0; i < r->recurrence.n_intervals; ++i)
             fprintf(f, "%.17g\t%.17g\n", r->recurrence.t[i], r->recurrence.interval[i]);
-        if ((rc = close_table(f, path, err)) != BK_OK)
+        if ((rc = bk_stats_close_table(f, path, err)) != BK_OK)
             return rc;
     }
     if (r->n_interevent > 0) {
         /* One block per threshold, blank lines between (gnuplot's index). */
-        if (!(f = open_table(dir, "interevent.tsv", path, sizeof path,
+        if (!(f = bk_stats_open_table(dir, "interevent.tsv", path, sizeof path,
                              "# magnitude_min[1]\ttheta[1]\tdensity[1]\tgamma_fit[1]", err)))
             return err ? err->status : BK_ERR_IO;
         for (size_t k = 0; k < r->n_interevent; ++k) {
@@ -509,9 +476,11 @@ int bk_stats_report_tsv(const bk_stats_report *r, const char *dir, bk_error *err
             if (k + 1 < r->n_interevent)
                 fprintf(f, "\n\n");
         }
-        if ((rc = close_table(f, path, err)) != BK_OK)
+        if ((rc = bk_stats_close_table(f, path, err)) != BK_OK)
             return rc;
     }
+    if ((rc = bk_stats_tsv_sequences(r, dir, err)) != BK_OK || (rc = bk_stats_tsv_scaling(r, dir, err)) != BK_OK)
+        return rc;
     if (r->potency && r->n_events)
         return potency_table(r, dir, path, sizeof path, err);
     return BK_OK;

@@ -5,10 +5,14 @@
  * A catalog needs only t_start and magnitude; the other fields of bksim's own catalogs
  * (potency, n_blocks, complete, t_end) add statistics when present. */
 #include "bksim/stats.h"
+#include "bksim/stats_scaling.h"
+#include "bksim/stats_truncated.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <gsl/gsl_errno.h>
 
 #define TWO_THIRDS (2.0 / 3.0)
 /* Magnitudes and potencies obey m = (2/3) log10 P + offset to this (in magnitude units) in
@@ -25,6 +29,9 @@ void bk_stats_options_default(bk_stats_options *opt)
     opt->t_to = INFINITY;
     opt->bootstrap = BK_BOOTSTRAP_DEFAULT;
     opt->seed = BK_BOOTSTRAP_SEED;
+    opt->mainshock_auto = 1;
+    opt->mainshock = 0.0;
+    opt->window = 0.0;
 }
 
 int bk_stats_options_check(const bk_stats_options *opt, bk_error *err)
@@ -42,6 +49,11 @@ int bk_stats_options_check(const bk_stats_options *opt, bk_error *err)
     if (opt->bootstrap > BK_BOOTSTRAP_MAX)
         return BK_FAIL(err, BK_ERR_INVALID, "bootstrap samples %zu: allowed 0 .. %d", opt->bootstrap,
                        BK_BOOTSTRAP_MAX);
+    if (!opt->mainshock_auto && !isfinite(opt->mainshock))
+        return BK_FAIL(err, BK_ERR_INVALID, "mainshock magnitude %g: must be finite", opt->mainshock);
+    if (!(isfinite(opt->window) && opt->window >= 0.0))
+        return BK_FAIL(err, BK_ERR_INVALID, "sequence window %g s: allowed > 0 (0: the span over the mainshock count)",
+                       opt->window);
     if (!opt->mc_auto) {
         double q = opt->mc / opt->dm;
         if (!(isfinite(q) && fabs(q) <= 1e15) || fabs(q - floor(q + 0.5)) > 1e-6)
@@ -236,8 +248,28 @@ static int other_estimators(bk_stats_report *r, bk_error *err)
     rc = bk_mc_b_stability(r->magnitude, r->n_events, o->dm, 0.5, &r->mc_stability, &inner);
     if (rc == BK_OK)
         r->have_mc_stability = 1;
+    else if ((rc = note_or_fail(rc, &inner, r->mc_stability_note, sizeof r->mc_stability_note, err)) != BK_OK)
+        return rc;
+    if (o->bootstrap == 0) {
+        snprintf(r->mc_ks_note, sizeof r->mc_ks_note, "the KS method draws synthetic samples: --bootstrap 0 draws none");
+        return BK_OK;
+    }
+    rc = bk_mc_ks(r->magnitude, r->n_events, o->dm, BK_MC_KS_P_PASS, o->bootstrap, o->seed + 3, &r->mc_ks, &inner);
+    if (rc != BK_OK)
+        return note_or_fail(rc, &inner, r->mc_ks_note, sizeof r->mc_ks_note, err);
+    if (r->mc_ks.found && r->mc_ks.n >= BK_B_SMALL_SAMPLE)
+        r->have_mc_ks = 1;
+    else if (r->mc_ks.found)
+        /* A few dozen of the largest events pass almost any test (the KS test has little power
+         * there): no completeness follows from it. */
+        snprintf(r->mc_ks_note, sizeof r->mc_ks_note,
+                 "the first candidate that passes the KS test at p >= %g, Mc = %g, leaves %zu events above it "
+                 "(fewer than %d, too few for the test to reject): every lower one fails",
+                 BK_MC_KS_P_PASS, r->mc_ks.mc, r->mc_ks.n, BK_B_SMALL_SAMPLE);
     else
-        return note_or_fail(rc, &inner, r->mc_stability_note, sizeof r->mc_stability_note, err);
+        snprintf(r->mc_ks_note, sizeof r->mc_ks_note,
+                 "no candidate of the %zu tested passes the KS test at p >= %g (the last: Mc = %g, p = %.3g)",
+                 r->mc_ks.n_tested, BK_MC_KS_P_PASS, r->mc_ks.mc, r->mc_ks.p);
     return BK_OK;
 }
 
@@ -268,6 +300,71 @@ static int interevent(bk_stats_report *r, const double *binned, bk_error *err)
         snprintf(r->interevent_note, sizeof r->interevent_note,
                  "fewer than %d events at or above Mc = %g: interevent times need that many", BK_INTEREVENT_MIN_EVENTS,
                  r->mc);
+    return BK_OK;
+}
+
+/* Potency against duration and length from Mc up (bksim/stats_scaling.h: the bands and the
+ * bracket of slopes are its). */
+static int scaling(bk_stats_report *r, bk_error *err)
+{
+    if (!r->potency) {
+        snprintf(r->scaling_note, sizeof r->scaling_note, "the catalog has no potency field");
+        return BK_OK;
+    }
+    bk_scaling_options opt;
+    bk_scaling_options_default(&opt);
+    opt.dm = r->options.dm;
+    opt.mc = r->mc;
+    /* A band of a magnitude unit holds whole bins whatever dm divides it; else one bin. */
+    double bins = floor(opt.band_width / opt.dm + 0.5);
+    opt.band_width = (bins >= 1.0 ? bins : 1.0) * opt.dm;
+    bk_scaling_columns columns = {r->n_events, r->t_start, r->t_end, r->magnitude, r->potency, r->n_blocks};
+    r->scaling = malloc(sizeof *r->scaling);
+    if (!r->scaling)
+        return BK_FAIL(err, BK_ERR_NOMEM, "out of memory for the scaling relations");
+    bk_error inner = {0};
+    int rc = bk_scaling_by_magnitude(&columns, &opt, r->scaling, &inner);
+    if (rc != BK_OK) {
+        free(r->scaling);
+        r->scaling = NULL;
+        return note_or_fail(rc, &inner, r->scaling_note, sizeof r->scaling_note, err);
+    }
+    return BK_OK;
+}
+
+/* Sequences around the events at or above the mainshock magnitude, of the events >= Mc (binned
+ * magnitudes: thresholds at lower bin edges). */
+static int sequences(bk_stats_report *r, const double *binned, bk_error *err)
+{
+    const bk_stats_options *o = &r->options;
+    double m_main = r->mc + BK_SEQUENCE_MAINSHOCK_STEP;
+    if (!o->mainshock_auto) {
+        long k = 0;
+        bk_mag_bin(o->mainshock, o->dm, &k, NULL);
+        m_main = (double)k * o->dm;
+    }
+    size_t count = 0;
+    for (size_t i = 0; i < r->n_events; ++i)
+        count += binned[i] >= m_main - 0.5 * o->dm;
+    if (count == 0) {
+        snprintf(r->sequences_note, sizeof r->sequences_note, "no event at or above the mainshock magnitude %g%s",
+                 m_main, o->mainshock_auto ? " (Mc + 2; --mainshock sets it)" : "");
+        return BK_OK;
+    }
+    if (!(r->duration > 0.0)) {
+        snprintf(r->sequences_note, sizeof r->sequences_note, "the observed span is empty");
+        return BK_OK;
+    }
+    double window = o->window > 0.0 ? o->window : r->duration / (double)count;
+    bk_error inner = {0};
+    int rc = bk_sequences_build(r->t_start, binned, r->n_events, r->mc - 0.5 * o->dm, m_main - 0.5 * o->dm, window,
+                                r->span_start, r->span_start + r->duration, &r->sequences, &inner);
+    if (rc != BK_OK)
+        return note_or_fail(rc, &inner, r->sequences_note, sizeof r->sequences_note, err);
+    /* The thresholds as bin centres, as Mc is reported. */
+    r->sequences.m_main = m_main;
+    r->sequences.m_min = r->mc;
+    r->have_sequences = 1;
     return BK_OK;
 }
 
@@ -302,6 +399,34 @@ static int test_gr(bk_stats_report *r, bk_error *err)
     return BK_OK;
 }
 
+/* The largest range [Mc, Mu] a GR law describes: where a size cutoff (the system-size bump)
+ * spoils the fit above Mc, the law below it still has a b. */
+static int truncation(bk_stats_report *r, bk_error *err)
+{
+    const bk_stats_options *o = &r->options;
+    if (o->bootstrap < BK_TRUNCATED_MIN_SYNTHETIC) {
+        snprintf(r->truncation_note, sizeof r->truncation_note,
+                 "the range scan tests each upper magnitude with at least %d synthetic samples: --bootstrap %zu",
+                 BK_TRUNCATED_MIN_SYNTHETIC, o->bootstrap);
+        return BK_OK;
+    }
+    r->truncation = malloc(sizeof *r->truncation);
+    if (!r->truncation)
+        return BK_FAIL(err, BK_ERR_NOMEM, "out of memory for the truncated GR fit");
+    bk_error inner = {0};
+    int rc = bk_gr_truncation_scan(r->magnitude, r->n_events, r->mc, o->dm, BK_TRUNCATED_MIN_BINS, o->bootstrap,
+                                   o->seed + 4, r->truncation, &inner);
+    if (rc == BK_OK && !r->truncation->found)
+        snprintf(r->truncation_note, sizeof r->truncation_note,
+                 "no range from Mc = %g up to %d bins or more passes the fit test at p >= %g (best p = %.3g, Mu = %g)",
+                 r->mc, BK_TRUNCATED_MIN_BINS, BK_GOF_LEVEL, r->truncation->gof.p, r->truncation->fit.mu);
+    if (rc == BK_OK && r->truncation->found)
+        return BK_OK;
+    free(r->truncation);
+    r->truncation = NULL;
+    return rc == BK_OK ? BK_OK : note_or_fail(rc, &inner, r->truncation_note, sizeof r->truncation_note, err);
+}
+
 /* Everything that needs Mc. */
 static int above_mc(bk_stats_report *r, bk_error *err)
 {
@@ -334,6 +459,8 @@ static int above_mc(bk_stats_report *r, bk_error *err)
         rc = test_gr(r, err);
     else
         rc = note_or_fail(rc, &inner, r->b_note, sizeof r->b_note, err);
+    if (rc == BK_OK)
+        rc = truncation(r, err);
     if (rc == BK_OK && r->potency)
         rc = fit_potency(r, binned, err);
     if (rc == BK_OK) {
@@ -348,6 +475,10 @@ static int above_mc(bk_stats_report *r, bk_error *err)
         rc = other_estimators(r, err);
     if (rc == BK_OK)
         rc = interevent(r, binned, err);
+    if (rc == BK_OK)
+        rc = sequences(r, binned, err);
+    if (rc == BK_OK)
+        rc = scaling(r, err);
     if (rc == BK_OK)
         rc = ks_halves(r, binned, err);
     free(binned);
@@ -384,7 +515,10 @@ static int select_events(bk_stats_report *r, const bk_event_table *t, bk_error *
     r->t_start = malloc(n * sizeof *r->t_start);
     r->magnitude = malloc(n * sizeof *r->magnitude);
     r->potency = t->potency ? malloc(n * sizeof *r->potency) : NULL;
-    if (!r->t_start || !r->magnitude || (t->potency && !r->potency))
+    r->t_end = t->t_end ? malloc(n * sizeof *r->t_end) : NULL;
+    r->n_blocks = t->n_blocks ? malloc(n * sizeof *r->n_blocks) : NULL;
+    if (!r->t_start || !r->magnitude || (t->potency && !r->potency) || (t->t_end && !r->t_end) ||
+        (t->n_blocks && !r->n_blocks))
         return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for %zu events", r->path, t->n);
     for (size_t i = 0; i < t->n; ++i) {
         if (t->complete && t->complete[i] == 0) {
@@ -404,6 +538,10 @@ static int select_events(bk_stats_report *r, const bk_event_table *t, bk_error *
         r->magnitude[k] = t->magnitude[i];
         if (r->potency)
             r->potency[k] = t->potency[i];
+        if (r->t_end)
+            r->t_end[k] = t->t_end[i];
+        if (r->n_blocks)
+            r->n_blocks[k] = t->n_blocks[i];
         if (k == 0 || t->t_start[i] < r->t_first)
             r->t_first = t->t_start[i];
         if (k == 0 || t->t_start[i] > r->t_last)
@@ -437,6 +575,8 @@ static int compute(bk_stats_report *r, const bk_event_table *t, bk_error *err)
         snprintf(r->recurrence_note, sizeof r->recurrence_note, "%s", none);
         snprintf(r->interevent_note, sizeof r->interevent_note, "%s", none);
         snprintf(r->ks_note, sizeof r->ks_note, "%s", none);
+        snprintf(r->sequences_note, sizeof r->sequences_note, "%s", none);
+        snprintf(r->scaling_note, sizeof r->scaling_note, "%s", none);
         if (r->has_potency)
             snprintf(r->potency_note, sizeof r->potency_note, "%s", none);
         return BK_OK;
@@ -449,6 +589,8 @@ static int compute(bk_stats_report *r, const bk_event_table *t, bk_error *err)
         snprintf(r->recurrence_note, sizeof r->recurrence_note, "%s", r->b_note);
         snprintf(r->interevent_note, sizeof r->interevent_note, "%s", r->b_note);
         snprintf(r->ks_note, sizeof r->ks_note, "%s", r->b_note);
+        snprintf(r->sequences_note, sizeof r->sequences_note, "%s", r->b_note);
+        snprintf(r->scaling_note, sizeof r->scaling_note, "%s", r->b_note);
         if (r->has_potency)
             snprintf(r->potency_note, sizeof r->potency_note, "%s", r->b_note);
         return rc;
@@ -479,7 +621,11 @@ int bk_stats_report_compute(const bk_event_table *table, const char *source,
         return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", source);
     }
     r->options = *opt;
+    /* An estimator GSL cannot complete (a simplex, a singular matrix) is a note in the
+     * report: GSL's default handler would abort the process instead. */
+    gsl_error_handler_t *handler = gsl_set_error_handler_off();
     rc = compute(r, table, err);
+    gsl_set_error_handler(handler);
     if (rc != BK_OK) {
         bk_stats_report_free(r);
         return rc;
@@ -497,10 +643,15 @@ void bk_stats_report_free(bk_stats_report *r)
     free(r->t_start);
     free(r->magnitude);
     free(r->potency);
+    free(r->t_end);
+    free(r->n_blocks);
+    free(r->scaling);
+    free(r->truncation);
     bk_mfd_free(&r->mfd);
     bk_recurrence_free(&r->recurrence);
     for (size_t k = 0; k < r->n_interevent; ++k)
         bk_interevent_free(&r->interevent[k]);
     bk_size_dist_free(&r->sizes);
+    bk_sequences_free(&r->sequences);
     free(r);
 }

@@ -301,6 +301,21 @@ static void test_commands(void **state)
     expect_command(cmd, 2, "--from needs a time in s, got '1e3x'");
     snprintf(cmd, sizeof cmd, "./bksim stats %s --from 30 --to 10", catalog);
     expect_command(cmd, 2, "time window [30, 10) s");
+    /* The mainshock sequences' options reach the report: the five 2.3s at t = 35..39 s are the
+     * candidates, the first the largest within 5 s (the others tie with an earlier one), and
+     * its window ends past the catalog's span (t = 39 s). */
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --mc 2.0 --mainshock 2.3 --window=5 --bootstrap 0", catalog);
+    expect_command(cmd, 0, "mainshock sequences (mainshocks: M >= 2.3, the largest within +-5 s; events M >= Mc = 2):\n"
+                           "  mainshocks: 0 of 5 events at or above 2.3 (4 with a larger or earlier equal event within "
+                           "+-5 s, 1 too near the span's ends)");
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --mc 2.0 --mainshock auto --window auto --json --bootstrap 0", catalog);
+    expect_command(cmd, 0, "\"sequences\": ");
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --window 0", catalog);
+    expect_command(cmd, 2, "--window needs 'auto' or a time > 0 in s, got '0'");
+    snprintf(cmd, sizeof cmd, "./bksim stats %s --mainshock big", catalog);
+    expect_command(cmd, 2, "--mainshock needs 'auto' or a magnitude, got 'big'");
+    snprintf(cmd, sizeof cmd, "./bksim summary %s --mainshock 2", tmpdir);
+    expect_command(cmd, 2, "unknown or incomplete option '--mainshock'");
     assert_int_equal(run_command("./bksim stats", NULL), 2);
 
     const char *helps[] = {"run", "check", "info", "export", "keys", "stats", "summary"};

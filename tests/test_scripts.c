@@ -90,6 +90,21 @@ static void test_plot_scripts(void **state)
     }
 }
 
+/* Every line of text naming a file under dir (the figures a plot script printed) exists;
+ * returns how many there were. */
+static int printed_files_exist(char *text, const char *dir)
+{
+    int count = 0;
+    for (char *line = strtok(text, "\n"); line; line = strtok(NULL, "\n")) {
+        if (strncmp(line, dir, strlen(dir)) != 0)
+            continue;
+        if (!path_exists(line))
+            fail_msg("%s: printed, but not written", line);
+        ++count;
+    }
+    return count;
+}
+
 /* The catalogs' scripts on a 40-block chain whose ends fail 1 ms apart and slip at once
  * (test_run_catalog.c's overlap scene): its first event holds two separate ruptures, which
  * event_ruptures.sh counts from /ruptures; plot_mfd.sh draws both figures of either catalog;
@@ -138,6 +153,21 @@ static void test_catalog_scripts(void **state)
     expect_command(cmd, 1, "no table /ruptures");
     snprintf(cmd, sizeof cmd, "scripts/plot_mfd.sh --table quakes %s", out);
     expect_command(cmd, 2, "--table must be ruptures or events");
+    /* plot_stats.sh on a catalog of two ruptures: no interevent times, no mainshock; each
+     * figure says why instead of drawing an empty frame. */
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_stats.sh --format svg -o %s/fig %s --from 0", bin, tmpdir, out);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_int_equal(printed_files_exist(text, tmpdir), 2);
+    free(text);
+    snprintf(cmd, sizeof cmd, "grep -l 'not available: ' %s/fig/ends_ruptures_interevent.svg %s/fig/ends_ruptures_omori.svg | wc -l",
+             tmpdir, tmpdir);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_string_equal(text, "2\n");
+    free(text);
+    snprintf(cmd, sizeof cmd, "scripts/plot_stats.sh %s --window", out);
+    expect_command(cmd, 2, "--window needs a value");
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_stats.sh -o %s/fig %s/bare.h5", bin, tmpdir, tmpdir);
+    expect_command(cmd, 1, "bare.h5: no /ruptures table");
 
     /* plot_slip_map.sh on a 4 x 5 lattice: the largest rupture, a chosen event, and rows past
      * either table's end. */
@@ -169,20 +199,6 @@ static void test_catalog_scripts(void **state)
     expect_command(cmd, 2, "--rupture K reads /ruptures");
 }
 
-/* Every line of text naming a file under dir (the figures a plot script printed) exists;
- * returns how many there were. */
-static int printed_files_exist(char *text, const char *dir)
-{
-    int count = 0;
-    for (char *line = strtok(text, "\n"); line; line = strtok(NULL, "\n")) {
-        if (strncmp(line, dir, strlen(dir)) != 0)
-            continue;
-        if (!path_exists(line))
-            fail_msg("%s: printed, but not written", line);
-        ++count;
-    }
-    return count;
-}
 
 /* plot_ruptures.sh on a 60-block chain (a second of stick-slip: about 70 ruptures of 1 to 28
  * blocks) and on a 4 x 5 lattice: its figures in png (the chain's four, the lattice's three:

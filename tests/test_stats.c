@@ -16,6 +16,8 @@
 
 #include "bk_test.h"
 #include "bksim/stats.h"
+#include "bksim/stats_scaling.h"
+#include "bksim/stats_truncated.h"
 #include "files.h"
 
 #define N_OF(a) (sizeof(a) / sizeof((a)[0]))
@@ -666,6 +668,15 @@ static void test_report_bksim_catalog(void **state)
     assert_close(rep->b.b, b.b, 1e-12, 0.0);
     assert_int_equal(rep->n_above_mc, b.n);
     assert_close(rep->b.b, 1.0, 0.0, 3.0 * rep->b.sigma);
+    /* Mc by the KS method is the estimator's (same seed), and the magnitudes are complete from
+     * 1.95 up (gr_sample tapers the smaller ones): the 2.0 bin, to a bin. */
+    bk_mc_ks_result mc_ks;
+    assert_int_equal(bk_mc_ks(m, n, 0.1, BK_MC_KS_P_PASS, opt.bootstrap, opt.seed + 3, &mc_ks, &err), BK_OK);
+    print_message("Mc: maximum curvature + 0.2 = %g, KS method %g (p = %.3f)\n", mc, rep->mc_ks.mc, rep->mc_ks.p);
+    assert_true(rep->have_mc_ks);
+    assert_close(rep->mc_ks.mc, mc_ks.mc, 0.0, 1e-12);
+    assert_close(rep->mc_ks.mc, 2.0, 0.0, 0.1 + 1e-9);
+    assert_true(rep->mc_ks.p >= BK_MC_KS_P_PASS);
     /* The potency threshold is the potency of Mc - dm/2, so the exponent sees the same
      * events as b, and beta = (2/3) b. */
     assert_true(rep->have_potency_exponent);
@@ -916,6 +927,210 @@ static void test_report_foreign_catalog(void **state)
     bk_stats_report_free(rep);
 }
 
+/* The report's mainshock sequences: mainshocks of magnitude 5 every 1,000 s, each followed by
+ * K / (t + c)^p aftershocks (p = 1.1) over a Poisson background; the stacked fit finds the
+ * decay within 2 of its errors, in text, JSON and omori.tsv, with the mainshock magnitude and
+ * the window given or by default (Mc + 2; the span over the mainshock count). */
+static void test_report_sequences(void **state)
+{
+    (void)state;
+    enum { CAP = 100000 };
+    double *t = malloc(CAP * sizeof *t), *m = malloc(CAP * sizeof *m);
+    assert_true(t && m);
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 1983);
+    const double span = 20000.0, window = 500.0, c = 0.1, p = 1.1;
+    size_t n = gsl_ran_poisson(rng, 0.005 * span);
+    for (size_t i = 0; i < n; ++i) {
+        t[i] = span * gsl_rng_uniform(rng);
+        m[i] = fmin(-log10(gsl_rng_uniform_pos(rng)), 3.9);
+    }
+    double total = (pow(window + c, 1.0 - p) - pow(c, 1.0 - p)) / (1.0 - p);
+    for (int j = 0; j < 19; ++j) {
+        double t0 = 1000.0 * (j + 1);
+        t[n] = t0;
+        m[n++] = 5.0;
+        size_t a = gsl_ran_poisson(rng, 20.0 * total);
+        for (size_t i = 0; i < a && n < CAP; ++i) {
+            double y = gsl_rng_uniform(rng) * total;
+            t[n] = t0 + pow(pow(c, 1.0 - p) + (1.0 - p) * y, 1.0 / (1.0 - p)) - c;
+            m[n++] = fmin(-log10(gsl_rng_uniform_pos(rng)), 3.9);
+        }
+    }
+    gsl_rng_free(rng);
+    bk_event_table table = {.n = n, .t_start = t, .magnitude = m, .t_reached = span};
+    bk_stats_options opt;
+    bk_stats_options_default(&opt);
+    opt.bootstrap = 0;
+    opt.mc_auto = 0;
+    opt.mc = 0.0;
+    opt.mainshock_auto = 0;
+    opt.mainshock = 4.96; /* its bin, 5.0 */
+    opt.window = window;
+    bk_stats_report *rep = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_stats_report_compute(&table, "sequences", &opt, &rep, &err), BK_OK);
+    assert_true(rep->have_sequences);
+    const bk_sequences *s = &rep->sequences;
+    assert_close(s->m_main, 5.0, 0.0, 1e-12);
+    assert_int_equal(s->n_mainshocks, 19);
+    assert_true(s->after.have_fit && s->after.fit.decays);
+    print_message("stacked: %zu aftershocks, p = %.4f +- %.4f\n", s->after.n, s->after.fit.p, s->after.fit.p_sigma);
+    assert_close(s->after.fit.p, p, 0.0, 2.0 * s->after.fit.p_sigma);
+    assert_true(s->after.have_residuals && s->after.residuals.p > BK_GOF_LEVEL);
+    assert_false(s->before.have_fit && s->before.fit.decays);
+
+    FILE *f = tmpfile();
+    assert_int_equal(bk_stats_report_text(rep, f, &err), BK_OK);
+    char *text = read_text(f);
+    fclose(f);
+    assert_non_null(strstr(text, "mainshocks: 19 of 19 events at or above 5"));
+    assert_non_null(strstr(text, "decays, 1 % level"));
+    free(text);
+    f = tmpfile();
+    assert_int_equal(bk_stats_report_json(rep, f, &err), BK_OK);
+    char *json = read_text(f);
+    fclose(f);
+    assert_non_null(strstr(json, "\"sequences\": {\"mainshock_magnitude\": 5, "));
+    assert_close(json_value(json, "n_mainshocks"), 19.0, 0.0, 0.0);
+    assert_non_null(strstr(json, "\"decays\": true"));
+    free(json);
+
+    char dir[128], file[512], first[256];
+    assert_int_equal(make_temp_dir(dir, sizeof dir, "bksim_sequences"), 0);
+    assert_int_equal(bk_stats_report_tsv(rep, dir, &err), BK_OK);
+    snprintf(file, sizeof file, "%s/omori.tsv", dir);
+    assert_true(count_lines(file, first, sizeof first) > 10);
+    assert_non_null(strstr(first, "rate_per_mainshock[1/s]"));
+    snprintf(file, sizeof file, "%s/omori_residuals.tsv", dir);
+    assert_true(count_lines(file, first, sizeof first) > s->after.n);
+    bk_stats_report_free(rep);
+    assert_int_equal(remove_tree(dir), 0);
+
+    /* By default: mainshocks from Mc + 2 = 2 (background events up to 3.9 among them), windows
+     * of the span over their count. */
+    bk_stats_options_default(&opt);
+    opt.bootstrap = 0;
+    opt.mc_auto = 0;
+    opt.mc = 0.0;
+    assert_int_equal(bk_stats_report_compute(&table, "sequences", &opt, &rep, &err), BK_OK);
+    assert_true(rep->have_sequences);
+    size_t candidates = 0;
+    for (size_t i = 0; i < n; ++i)
+        candidates += m[i] >= 1.95;
+    assert_int_equal(rep->sequences.n_candidates, candidates);
+    assert_close(rep->sequences.window, span / (double)candidates, 1e-12, 0.0);
+    bk_stats_report_free(rep);
+
+    /* No event that large: a reason, not a number. */
+    opt.mainshock_auto = 0;
+    opt.mainshock = 7.0;
+    assert_int_equal(bk_stats_report_compute(&table, "sequences", &opt, &rep, &err), BK_OK);
+    assert_false(rep->have_sequences);
+    assert_non_null(strstr(rep->sequences_note, "no event at or above the mainshock magnitude 7"));
+    bk_stats_report_free(rep);
+    opt.window = -1.0;
+    assert_int_equal(bk_stats_report_compute(&table, "sequences", &opt, &rep, &err), BK_ERR_INVALID);
+    assert_non_null(strstr(err.message, "sequence window -1 s: allowed > 0"));
+    free(t);
+    free(m);
+}
+
+/* A chain-like catalog: GR (b = 1) from M 0 to 2 and a bump of system-size events at 3 (3 %),
+ * potency P = 10^(1.5 (M - OFFSET)), duration T with P ~ T^2 and length L with P ~ L^1.5 (each
+ * with 0.05 decades of scatter).  The report withholds the untruncated b (the bump), finds the
+ * cutoff (Mu in [1.8, 2.0], the bump left out, b within 2 errors of 1), and gives the scaling
+ * exponents within their brackets, in text, JSON and TSV. */
+static void test_report_cutoff_and_scaling(void **state)
+{
+    (void)state;
+    enum { N = 3000 };
+    catalog c;
+    catalog_init(&c, N);
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 2019);
+    double t = 0.0;
+    for (size_t i = 0; i < N; ++i) {
+        double m;
+        if (gsl_rng_uniform(rng) < 0.03)
+            m = 3.0 + gsl_ran_flat(rng, -0.1, 0.1);
+        else
+            do
+                m = -0.05 - log10(gsl_rng_uniform_pos(rng));
+            while (m >= 2.05);
+        t += gsl_ran_exponential(rng, 1.0);
+        c.potency[i] = pow(10.0, 1.5 * (m - OFFSET));
+        c.magnitude[i] = 2.0 / 3.0 * log10(c.potency[i]) + OFFSET;
+        c.t_start[i] = t;
+        c.t_end[i] = t + sqrt(c.potency[i]) * pow(10.0, gsl_ran_gaussian(rng, 0.05));
+        c.n_blocks[i] = (int32_t)fmax(2.0, floor(1e3 * pow(c.potency[i], 1.0 / 1.5) * pow(10.0, gsl_ran_gaussian(rng, 0.05))));
+        c.complete[i] = 1;
+    }
+    gsl_rng_free(rng);
+    bk_event_table table = table_of(&c, t + 1.0);
+    bk_stats_options opt;
+    bk_stats_options_default(&opt);
+    opt.bootstrap = 300;
+    opt.mc_auto = 0;
+    opt.mc = 0.0;
+    bk_stats_report *rep = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_stats_report_compute(&table, "cutoff", &opt, &rep, &err), BK_OK);
+    assert_false(rep->have_b);
+    assert_non_null(rep->truncation);
+    const bk_b_truncated_estimate *f = &rep->truncation->fit;
+    print_message("truncated GR: b = %.4f +- %.4f over %g..%g, %zu above\n", f->b, f->sigma, f->mc, f->mu, f->n_above);
+    assert_true(f->mu > 1.8 - 1e-9 && f->mu < 2.0 + 1e-9);
+    assert_true(f->n_above > 50);
+    assert_close(f->b, 1.0, 0.0, 2.0 * f->sigma);
+    assert_non_null(rep->scaling);
+    const bk_scaling_band *all = &rep->scaling->all;
+    assert_true(all->have_duration && all->have_length);
+    print_message("scaling: duration %.4f [%.4f], length %.4f [%.4f]\n", all->duration.slope, all->duration.slope_inverse,
+                  all->length.slope, all->length.slope_inverse);
+    assert_true(all->duration.slope <= 2.0 + 3.0 * all->duration.slope_sigma && all->duration.slope_inverse >= 2.0 - 0.05);
+    assert_close(all->duration.slope, 2.0, 0.0, 0.1);
+    assert_close(all->length.slope, 1.5, 0.0, 0.1);
+
+    FILE *out = tmpfile();
+    assert_int_equal(bk_stats_report_text(rep, out, &err), BK_OK);
+    char *text = read_text(out);
+    fclose(out);
+    assert_non_null(strstr(text, "above Mu (up to 3"));
+    assert_non_null(strstr(text, "left out: a size cutoff"));
+    assert_non_null(strstr(text, "moment-duration exponent (M >= Mc) against Thøgersen et al. 2019"));
+    free(text);
+    out = tmpfile();
+    assert_int_equal(bk_stats_report_json(rep, out, &err), BK_OK);
+    char *json = read_text(out);
+    fclose(out);
+    assert_non_null(strstr(json, "\"gr_truncated\": {\"b_value\": "));
+    assert_close(json_value(json, "magnitude_top"), 3.1, 0.0, 0.1 + 1e-9);
+    assert_non_null(strstr(json, "\"scaling\": {\"min_blocks\": 2, "));
+    assert_null(strstr(json, "nan"));
+    free(json);
+    char dir[128], file[512], first[256];
+    assert_int_equal(make_temp_dir(dir, sizeof dir, "bksim_cutoff"), 0);
+    assert_int_equal(bk_stats_report_tsv(rep, dir, &err), BK_OK);
+    snprintf(file, sizeof file, "%s/gr_truncated_fit.tsv", dir);
+    assert_int_equal(count_lines(file, first, sizeof first), 1 + f->n_bins);
+    snprintf(file, sizeof file, "%s/scaling_duration.tsv", dir);
+    assert_true(count_lines(file, first, sizeof first) > 5);
+    assert_non_null(strstr(first, "median_potency[m]"));
+    snprintf(file, sizeof file, "%s/scaling_length.tsv", dir);
+    assert_true(count_lines(file, first, sizeof first) > 5);
+    assert_int_equal(remove_tree(dir), 0);
+    bk_stats_report_free(rep);
+
+    /* Too few synthetic samples for the range scan: a reason, not a fit. */
+    opt.bootstrap = 100;
+    assert_int_equal(bk_stats_report_compute(&table, "cutoff", &opt, &rep, &err), BK_OK);
+    assert_null(rep->truncation);
+    assert_non_null(strstr(rep->truncation_note, "at least 200 synthetic samples: --bootstrap 100"));
+    bk_stats_report_free(rep);
+    catalog_free(&c);
+}
+
 static void test_report_errors(void **state)
 {
     (void)state;
@@ -969,6 +1184,8 @@ int main(void)
         cmocka_unit_test(test_ks_samples),
         cmocka_unit_test(test_report_bksim_catalog),
         cmocka_unit_test(test_report_foreign_catalog),
+        cmocka_unit_test(test_report_sequences),
+        cmocka_unit_test(test_report_cutoff_and_scaling),
         cmocka_unit_test(test_report_errors),
     };
     return cmocka_run_group_tests_name("stats", tests, NULL, NULL);

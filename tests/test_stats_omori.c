@@ -79,6 +79,47 @@ static void test_poisson(void **state)
     gsl_rng_free(rng);
 }
 
+/* Ogata's residual check: transformed by the true or fitted law, an Omori sequence is a
+ * unit-rate Poisson process (KS p not small, the expected count matching n); transformed by a
+ * law with the wrong p it is not (p < 0.01), so the check can fail. */
+static void test_residuals(void **state)
+{
+    (void)state;
+    enum { CAP = 10000 };
+    static double t[CAP];
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 1987);
+    size_t n = omori_sequence(rng, 100.0, 0.01, 1.1, t, CAP);
+    bk_error err = {0};
+    bk_omori fit;
+    assert_int_equal(bk_omori_fit(t, n, 0.0, T_END, &fit, &err), BK_OK);
+    bk_omori_residuals res;
+    assert_int_equal(bk_omori_residual_check(t, n, &fit, &res, &err), BK_OK);
+    print_message("fitted: %zu events, expected %.2f, KS D = %.4f, p = %.3f\n", n, res.tau_end, res.d, res.p);
+    assert_int_equal(res.n, n);
+    /* K = n / A: the fitted law expects exactly the events it was fitted to. */
+    assert_close(res.tau_end, (double)n, 1e-9, 0.0);
+    assert_true(res.p > 0.05);
+    for (size_t i = 1; i < n; ++i)
+        assert_true(res.tau[i] >= res.tau[i - 1]);
+    bk_omori_residuals_free(&res);
+
+    bk_omori wrong = fit;
+    wrong.p = fit.p - 0.3;
+    double a = (pow(T_END + wrong.c, 1.0 - wrong.p) - pow(wrong.c, 1.0 - wrong.p)) / (1.0 - wrong.p);
+    wrong.k = (double)n / a;
+    assert_int_equal(bk_omori_residual_check(t, n, &wrong, &res, &err), BK_OK);
+    print_message("p lowered by 0.3: KS D = %.4f, p = %.3g\n", res.d, res.p);
+    assert_true(res.p < 0.01);
+    bk_omori_residuals_free(&res);
+
+    double outside = T_END + 1.0;
+    assert_int_equal(bk_omori_residual_check(&outside, 1, &fit, &res, &err), BK_ERR_INVALID);
+    assert_non_null(strstr(err.message, "lies outside the fit's window"));
+    assert_null(res.tau);
+    gsl_rng_free(rng);
+}
+
 static void test_errors(void **state)
 {
     (void)state;
@@ -98,6 +139,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_recovers),
         cmocka_unit_test(test_poisson),
+        cmocka_unit_test(test_residuals),
         cmocka_unit_test(test_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -160,6 +160,7 @@ int bk_mc_b_stability(const double *m, size_t n, double dm, double range, bk_mc_
  * above it pass a KS test against their bk_b_tinti GR fit at p >= p_pass, p the fraction of
  * n_synthetic samples from that law at least as far from it.  out holds the last candidate
  * tested (the passing one when found). */
+#define BK_MC_KS_P_PASS 0.1 /* SeismoStats' default */
 typedef struct bk_mc_ks_result {
     int found;
     double mc, b, d, p;
@@ -302,6 +303,10 @@ void bk_interevent_free(bk_interevent *ie);
 /* ------------------------------------------------------------ Omori-Utsu --- */
 
 #define BK_OMORI_MIN_EVENTS 10
+/* p is sought in (BK_OMORI_P_LOWEST, BK_OMORI_P_HIGHEST): a rate that rises or falls faster
+ * is no Omori sequence, and the fit ends at the bound. */
+#define BK_OMORI_P_LOWEST (-1.0)
+#define BK_OMORI_P_HIGHEST 5.0
 /* The 99 % quantile of chi-square with 2 degrees of freedom: the likelihood ratio of the
  * Omori-Utsu law against a constant rate (K, c, p against one rate) above it is a decay. */
 #define BK_OMORI_LR_CHI2_2DOF_1PC 9.2103403719761836
@@ -319,6 +324,67 @@ typedef struct bk_omori {
 /* Maximum-likelihood Omori-Utsu fit (Ogata 1983; src/stats_omori.c) of n >= BK_OMORI_MIN_EVENTS
  * times t (s after the mainshock, in [start, end], any order). */
 int bk_omori_fit(const double *t, size_t n, double start, double end, bk_omori *out, bk_error *err);
+
+/* Ogata's residual check of a fit (SAPP's respoi): the times transformed by the fitted
+ * cumulative rate, tau_i = K int_start^t_i (u + c)^-p du, are a unit-rate Poisson process on
+ * [0, tau_end] when the law holds; d and p are the one-sample KS test of tau / tau_end against
+ * the uniform law (asymptotic p, conservative since the fit used the same times). */
+typedef struct bk_omori_residuals {
+    size_t n;
+    double *tau;      /* sorted transformed times (malloc'ed) */
+    double tau_end;   /* the fitted number of events in the window */
+    double d, p;
+} bk_omori_residuals;
+int bk_omori_residual_check(const double *t, size_t n, const bk_omori *fit, bk_omori_residuals *out, bk_error *err);
+void bk_omori_residuals_free(bk_omori_residuals *res);
+
+/* ------------------------------------------------- mainshock sequences --- */
+
+/* Sequences around mainshocks (src/stats_sequences.c), stacked in the superposed-epoch way:
+ * a mainshock is an event of magnitude >= m_main that is the largest within +-window of its
+ * start (an equal magnitude earlier in the window takes precedence) and whose +-window lies
+ * inside the observed span [span_start, span_end]; its aftershocks are the events of
+ * magnitude >= m_min starting in (t, t + window], its foreshocks those in [t - window, t),
+ * as offsets from t.  The offsets of every mainshock are fitted together by bk_omori_fit
+ * (K is then the sum over mainshocks) and each sequence with enough aftershocks alone;
+ * both stacks get Ogata's residual check.  Other events of magnitude >= m_main inside a
+ * window (smaller than its mainshock) stay in it with their own sequences: the stack is of
+ * everything that follows a mainshock, as in the catalogs the law was found in. */
+#define BK_SEQUENCE_MAINSHOCK_STEP 2.0 /* the report's default m_main: Mc + 2 */
+
+typedef struct bk_sequence {
+    double t_main, m_main;
+    size_t n_after, n_before;
+    int have_fit;              /* its own aftershocks fitted (>= BK_OMORI_MIN_EVENTS of them) */
+    bk_omori fit;
+} bk_sequence;
+
+typedef struct bk_sequence_stack {
+    size_t n;                  /* offsets in every window */
+    double *offset;            /* s from the mainshocks, > 0, <= window (malloc'ed) */
+    int have_fit;
+    bk_omori fit;              /* over [0, window] */
+    int have_residuals;
+    bk_omori_residuals residuals;
+    char note[BK_ERROR_MESSAGE_LEN]; /* why there is no fit */
+} bk_sequence_stack;
+
+typedef struct bk_sequences {
+    double m_main, m_min, window;
+    size_t n_candidates;       /* events at or above m_main */
+    size_t n_not_largest;      /* a larger (or equal, earlier) event within +-window */
+    size_t n_at_edges;         /* +-window not inside the observed span */
+    size_t n_simultaneous;     /* events starting at a mainshock's instant: in neither stack */
+    size_t n_mainshocks;
+    bk_sequence *sequence;     /* the mainshocks in time order (malloc'ed) */
+    size_t n_fitted;           /* sequences with have_fit */
+    bk_sequence_stack after, before;
+} bk_sequences;
+
+/* t, m: n events in any order (finite).  window > 0 s; span_start < span_end. */
+int bk_sequences_build(const double *t, const double *m, size_t n, double m_min, double m_main, double window,
+                       double span_start, double span_end, bk_sequences *out, bk_error *err);
+void bk_sequences_free(bk_sequences *s);
 
 /* ------------------------------------------------------ Kolmogorov-Smirnov --- */
 
@@ -353,6 +419,12 @@ typedef struct bk_stats_options {
      * (BK_BOOTSTRAP_DEFAULT; 0: neither, the fits reported untested), and their seed. */
     size_t bootstrap;
     unsigned long seed;
+    /* Mainshock sequences: mainshocks of magnitude >= mainshock (its bin), or Mc +
+     * BK_SEQUENCE_MAINSHOCK_STEP when mainshock_auto; windows of +-window s, or (window 0)
+     * the observed span over the number of events at or above the mainshock magnitude. */
+    int mainshock_auto;
+    double mainshock;
+    double window;
 } bk_stats_options;
 
 void bk_stats_options_default(bk_stats_options *opt);
@@ -382,6 +454,9 @@ void bk_event_table_free(bk_event_table *table);
 /* Everything `bksim stats` reports about one catalog.  A statistic the catalog cannot
  * support (too few events above Mc, no potency field...) has have_* = 0 and the reason in
  * its *_note; the report as a whole fails only when the file is no catalog. */
+struct bk_scaling;        /* bksim/stats_scaling.h */
+struct bk_gr_truncation;  /* bksim/stats_truncated.h */
+
 typedef struct bk_stats_report {
     char *path;
     char *table;           /* the catalog's table (bk_event_table's name), NULL when unnamed */
@@ -396,6 +471,8 @@ typedef struct bk_stats_report {
     size_t n_events;       /* the rest: the events every magnitude statistic uses */
     /* the analysed events, in file order */
     double *t_start, *magnitude, *potency;  /* potency NULL without the field */
+    double *t_end;         /* NULL without the field */
+    int32_t *n_blocks;     /* NULL without the field */
     double t_first, t_last;
     double span_start;     /* s: where the observed span begins (0 for a run, else t_first),
                             * t_from when that is later */
@@ -418,12 +495,19 @@ typedef struct bk_stats_report {
     bk_gof gr_gof;                 /* when p < BK_GOF_LEVEL, have_b is 0 and b_note says why */
     int have_b_spread;
     bk_b_spread b_spread;          /* bootstrap errors of b and Mc */
+    /* GR on [Mc, Mu], Mu the largest magnitude whose range passes the fit test (NULL: see
+     * the note; needs options.bootstrap >= BK_TRUNCATED_MIN_SYNTHETIC) */
+    struct bk_gr_truncation *truncation;
+    char truncation_note[BK_ERROR_MESSAGE_LEN];
     int have_b_positive;
     bk_b_positive_estimate b_positive; /* at Mc, dMc = dm, in start-time order */
     char b_positive_note[BK_ERROR_MESSAGE_LEN];
     int have_mc_stability;
     bk_mc_stability mc_stability;  /* Mc by b-value stability, range 0.5 (beside maximum curvature) */
     char mc_stability_note[BK_ERROR_MESSAGE_LEN];
+    int have_mc_ks;
+    bk_mc_ks_result mc_ks;         /* Mc by the KS method, p >= BK_MC_KS_P_PASS, options.bootstrap samples */
+    char mc_ks_note[BK_ERROR_MESSAGE_LEN];
     int have_potency_exponent;
     bk_power_law potency_fit;
     int have_potency_gof;
@@ -440,6 +524,11 @@ typedef struct bk_stats_report {
     int have_sizes;
     bk_size_dist sizes;            /* complete events, any magnitude */
     char sizes_note[BK_ERROR_MESSAGE_LEN];
+    struct bk_scaling *scaling;    /* potency against duration and length (NULL: see the note) */
+    char scaling_note[BK_ERROR_MESSAGE_LEN];
+    int have_sequences;
+    bk_sequences sequences;        /* mainshocks, stacked aftershocks and foreshocks (>= Mc) */
+    char sequences_note[BK_ERROR_MESSAGE_LEN];
     int have_ks;
     bk_ks_result ks;               /* magnitudes >= Mc, first vs second half of the time span */
     double ks_t_split;

@@ -14,10 +14,11 @@ int bk_cli_wants_help(int argc, char **argv);
 int bk_cli_usage_error(const char *command, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /* ---- catalog_commands.c ---- */
-/* bksim export, stats and summary with their arguments (after the command word); the exit
- * status. */
+/* bksim export, stats, compare and summary with their arguments (after the command word);
+ * the exit status. */
 int bk_cli_export(int argc, char **argv);
 int bk_cli_stats(int argc, char **argv);
+int bk_cli_compare(int argc, char **argv);
 int bk_cli_summary(int argc, char **argv);
 
 #endif

@@ -1,6 +1,6 @@
 /* bksim command line: a thin client of the library, the only place that calls exit; this
  * file runs and checks configs and dispatches, cli/catalog_commands.c reads outputs
- * (export, stats, summary).
+ * (export, stats, compare, summary).
  *
  * Exit status: 0 success, 1 the run or the file failed (or is damaged), 2 bad usage or bad
  * config, 3 (info) an intact file of a run that did not finish. */
@@ -36,9 +36,12 @@ static const char *const usage_text =
     "  export OUT.h5 --events\n"
     "                       print the event catalog /events as TSV\n"
     "  stats FILE [--table NAME] [--mc auto|VALUE] [--bin DM] [--from T] [--to T] [--bootstrap N]\n"
-    "        [--json] [--tsv DIR]\n"
+    "        [--mainshock auto|M] [--window auto|T] [--json] [--tsv DIR]\n"
     "                       earthquake statistics of the rupture catalog /ruptures in FILE\n"
     "                       (else /events; --table events: the time-window catalog)\n"
+    "  compare A.h5 B.h5 [--table NAME] [--from T] [--to T] [--round R] [--level L] [--json]\n"
+    "                       do two catalogs have the same statistics? KS tests of their\n"
+    "                       rupture sizes (log10 potency), magnitudes and n_blocks\n"
     "  summary DIR [--table NAME] [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
     "                       one row per finished run in DIR (a sweep): its --set values\n"
     "                       and headline figures, as DIR/summary.tsv and DIR/summary.h5\n"
@@ -520,6 +523,8 @@ int main(int argc, char **argv)
         return bk_cli_export(rest, rest_argv);
     if (strcmp(command, "stats") == 0)
         return bk_cli_stats(rest, rest_argv);
+    if (strcmp(command, "compare") == 0)
+        return bk_cli_compare(rest, rest_argv);
     if (strcmp(command, "summary") == 0)
         return bk_cli_summary(rest, rest_argv);
     if (strcmp(command, "keys") == 0) {
