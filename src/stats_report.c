@@ -49,8 +49,9 @@ int bk_stats_options_check(const bk_stats_options *opt, bk_error *err)
     if (opt->bootstrap > BK_BOOTSTRAP_MAX)
         return BK_FAIL(err, BK_ERR_INVALID, "bootstrap samples %zu: allowed 0 .. %d", opt->bootstrap,
                        BK_BOOTSTRAP_MAX);
-    if (!opt->mainshock_auto && !isfinite(opt->mainshock))
-        return BK_FAIL(err, BK_ERR_INVALID, "mainshock magnitude %g: must be finite", opt->mainshock);
+    if (!opt->mainshock_auto && !(isfinite(opt->mainshock) && fabs(opt->mainshock / opt->dm) <= 1e15))
+        return BK_FAIL(err, BK_ERR_INVALID, "mainshock magnitude %g: allowed finite, within 1e15 bins of 0",
+                       opt->mainshock);
     if (!(isfinite(opt->window) && opt->window >= 0.0))
         return BK_FAIL(err, BK_ERR_INVALID, "sequence window %g s: allowed > 0 (0: the span over the mainshock count)",
                        opt->window);

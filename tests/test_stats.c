@@ -1032,6 +1032,10 @@ static void test_report_sequences(void **state)
     opt.window = -1.0;
     assert_int_equal(bk_stats_report_compute(&table, "sequences", &opt, &rep, &err), BK_ERR_INVALID);
     assert_non_null(strstr(err.message, "sequence window -1 s: allowed > 0"));
+    opt.window = 0.0;
+    opt.mainshock = 1e300;
+    assert_int_equal(bk_stats_report_compute(&table, "sequences", &opt, &rep, &err), BK_ERR_INVALID);
+    assert_non_null(strstr(err.message, "mainshock magnitude 1e+300: allowed finite, within 1e15 bins"));
     free(t);
     free(m);
 }
