@@ -49,6 +49,18 @@ json_in() {
 json() { grep -o "\"$1\": [^,}]*" "$tmp/stats.json" | head -n 1 | sed 's/^[^:]*: //'; }
 note() { grep -o "\"$1\": \"[^\"]*\"" "$tmp/stats.json" | head -n 1 | sed 's/^[^:]*: "//; s/"$//'; }
 num() { LC_ALL=C printf "%.${2}${3:-f}" "$1" | sed 's/^-/−/'; }
+# note_figure OUT WHAT NOTE: a figure that holds why WHAT is not available, not an empty frame.
+note_figure() {
+    gnuplot <<GP || bk_fail 1 "gnuplot failed drawing $1"
+set encoding utf8
+set terminal $terminal
+set output '$(bk_gp_quote "$1")'
+set title '$(bk_gp_quote "$stem"): $2 of the $table'
+unset border; unset tics
+set label 1 'not available: $(bk_gp_quote "$3")' at graph 0.5, graph 0.5 center
+plot [0:1] [0:1] NaN notitle
+GP
+}
 n_events=$(json n_events)
 [ "$n_events" -gt 0 ] || bk_fail 1 "$file: /$table has no complete row with a finite magnitude: nothing to plot"
 
@@ -88,15 +100,7 @@ set samples 400
 $plot
 GP
 else
-    gnuplot <<GP || bk_fail 1 "gnuplot failed drawing $ie_out"
-set encoding utf8
-set terminal $terminal
-set output '$(bk_gp_quote "$ie_out")'
-set title '$(bk_gp_quote "$stem"): interevent times of the $table'
-unset border; unset tics
-set label 1 'not available: $(bk_gp_quote "$(note interevent_note)")' at graph 0.5, graph 0.5 center
-plot [0:1] [0:1] NaN notitle
-GP
+    note_figure "$ie_out" "interevent times" "$(note interevent_note)"
 fi
 
 # --------------------------------------------------------------- (b) Omori ---
@@ -150,15 +154,7 @@ plot '$tmp/stats/omori_residuals.tsv' index 0 using 1:2 with steps lw 2 lc rgb '
 unset multiplot
 GP
 else
-    gnuplot <<GP || bk_fail 1 "gnuplot failed drawing $omori_out"
-set encoding utf8
-set terminal $terminal
-set output '$(bk_gp_quote "$omori_out")'
-set title '$(bk_gp_quote "$stem"): mainshock sequences of the $table'
-unset border; unset tics
-set label 1 'not available: $(bk_gp_quote "$(note sequences_note)")' at graph 0.5, graph 0.5 center
-plot [0:1] [0:1] NaN notitle
-GP
+    note_figure "$omori_out" "mainshock sequences" "$(note sequences_note)"
 fi
 echo "$ie_out"
 echo "$omori_out"

@@ -2,6 +2,7 @@
  * potency exponent, event sizes, recurrence intervals and the two-sample KS test.  The
  * estimators and their references are in include/bksim/stats.h. */
 #include "bksim/stats.h"
+#include "stats_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -137,13 +138,11 @@ static int mc_bin(double mc, double dm, long *k, bk_error *err)
         return rc;
     if (!isfinite(mc))
         return BK_FAIL(err, BK_ERR_INVALID, "Mc = %g: must be finite", mc);
-    double q = mc / dm;
-    if (!(fabs(q) <= MAX_BIN_INDEX) || fabs(q - floor(q + 0.5)) > 1e-6)
+    if (!bk_stats_centre_bin(mc, dm, k))
         return BK_FAIL(err, BK_ERR_INVALID,
                        "Mc = %g is not a bin centre: it must be a multiple of the bin width "
                        "dm = %g",
                        mc, dm);
-    *k = (long)floor(q + 0.5);
     return BK_OK;
 }
 

@@ -33,11 +33,6 @@ int bk_compare_options_check(const bk_compare_options *opt, bk_error *err)
     return BK_OK;
 }
 
-static int in_window(const bk_compare_options *opt, double t)
-{
-    return !(t < opt->t_from) && !(t >= opt->t_to);
-}
-
 static double rounded(double x, double round)
 {
     return round > 0.0 ? bk_stats_to_bin(x, round) : x;
@@ -95,29 +90,18 @@ static int select_side(const bk_event_table *t, const char *name, const bk_compa
     v->n_blocks = s->has_n_blocks ? malloc(cap * sizeof *v->n_blocks) : NULL;
     if (!v->magnitude || (s->has_potency && !v->log10_potency) || (s->has_n_blocks && !v->n_blocks))
         return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for %zu events", s->source, t->n);
-    double t_first = INFINITY, t_last = -INFINITY, end = -INFINITY, blocks = 0.0;
-    for (size_t i = 0; i < t->n; ++i) {
-        if (t->complete && t->complete[i] == 0) {
-            ++s->n_incomplete;
-            continue;
-        }
-        if (!isfinite(t->t_start[i]) || !isfinite(t->magnitude[i])) {
-            ++s->n_nonfinite;
-            continue;
-        }
-        if (!in_window(opt, t->t_start[i])) {
-            ++s->n_outside;
-            continue;
-        }
-        size_t k = s->n_events++;
-        double m = t->magnitude[i];
-        v->magnitude[k] = rounded(m, opt->round);
-        s->m_min = k == 0 ? m : fmin(s->m_min, m);
-        s->m_max = k == 0 ? m : fmax(s->m_max, m);
-        t_first = fmin(t_first, t->t_start[i]);
-        t_last = fmax(t_last, t->t_start[i]);
-        if (t->t_end && isfinite(t->t_end[i]))
-            end = fmax(end, t->t_end[i]);
+    bk_event_selection sel;
+    int rc = bk_event_select(t, opt->t_from, opt->t_to, &sel, err);
+    if (rc != BK_OK)
+        return rc;
+    s->n_events = sel.n_events;
+    s->n_incomplete = sel.n_incomplete;
+    s->n_nonfinite = sel.n_nonfinite;
+    s->n_outside = sel.n_outside;
+    double blocks = 0.0;
+    for (size_t k = 0; k < sel.n_events; ++k) {
+        size_t i = sel.index[k];
+        v->magnitude[k] = rounded(t->magnitude[i], opt->round);
         if (v->log10_potency && isfinite(t->potency[i]) && t->potency[i] > 0.0)
             v->log10_potency[s->n_potency++] = rounded(log10(t->potency[i]), opt->round);
         if (v->n_blocks) {
@@ -125,24 +109,20 @@ static int select_side(const bk_event_table *t, const char *name, const bk_compa
             blocks += v->n_blocks[k];
         }
     }
-    if (s->n_events == 0)
+    if (s->n_events == 0) {
+        bk_event_selection_free(&sel);
         return BK_FAIL(err, BK_ERR_INVALID,
                        "%s: no event to compare: of %zu rows, %zu still running at the end (complete = 0), "
                        "%zu without a finite t_start and magnitude, %zu outside the time window",
                        s->source, s->n_rows, s->n_incomplete, s->n_nonfinite, s->n_outside);
-    /* The span: the run's (from t = 0 to t_reached) when known and after every start, else the
-     * catalog's own; clipped to the window. */
-    double start = t_first, stop = fmax(t_last, end);
-    if (isfinite(t->t_reached) && t->t_reached > 0.0 && t->t_reached >= t_last) {
-        start = 0.0;
-        stop = t->t_reached;
-        s->duration_from_run = 1;
     }
-    start = fmax(start, opt->t_from);
-    stop = fmin(stop, opt->t_to);
-    s->span_start = start;
-    s->duration = stop > start ? stop - start : 0.0;
+    s->m_min = sel.m_min;
+    s->m_max = sel.m_max;
+    s->span_start = sel.span_start;
+    s->duration = sel.duration;
+    s->duration_from_run = sel.duration_from_run;
     s->rate = s->duration > 0.0 ? (double)s->n_events / s->duration : 0.0;
+    bk_event_selection_free(&sel);
     if (v->n_blocks)
         s->n_blocks_mean = blocks / (double)s->n_events;
     if (v->log10_potency && s->n_potency) /* sorts them: the KS test does not mind */

@@ -14,6 +14,18 @@ static inline double bk_stats_to_bin(double x, double dx)
     return floor(x / dx + 0.5 + 1e-12) * dx;
 }
 
+/* Whether x is a bin centre, a multiple of dm to within 1e-6 of a bin (and within 1e15 bins
+ * of 0, where bin indices are whole numbers), the test every given Mc or Mu passes; its bin
+ * in *k when it is. */
+static inline int bk_stats_centre_bin(double x, double dm, long *k)
+{
+    double q = x / dm;
+    if (!(isfinite(q) && fabs(q) <= 1e15) || fabs(q - floor(q + 0.5)) > 1e-6)
+        return 0;
+    *k = (long)floor(q + 0.5);
+    return 1;
+}
+
 /* A bin offset k >= 0 of the binned GR law, P(K >= k) = q^k, drawn by inversion (log_q =
  * ln q < 0). */
 static inline long bk_stats_draw_offset(gsl_rng *rng, double log_q)

@@ -7,6 +7,7 @@
 #include "bksim/stats.h"
 #include "bksim/stats_scaling.h"
 #include "bksim/stats_truncated.h"
+#include "stats_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -56,8 +57,8 @@ int bk_stats_options_check(const bk_stats_options *opt, bk_error *err)
         return BK_FAIL(err, BK_ERR_INVALID, "sequence window %g s: allowed > 0 (0: the span over the mainshock count)",
                        opt->window);
     if (!opt->mc_auto) {
-        double q = opt->mc / opt->dm;
-        if (!(isfinite(q) && fabs(q) <= 1e15) || fabs(q - floor(q + 0.5)) > 1e-6)
+        long k = 0;
+        if (!bk_stats_centre_bin(opt->mc, opt->dm, &k))
             return BK_FAIL(err, BK_ERR_INVALID,
                            "Mc = %g: must be a bin centre, a multiple of the bin width %g "
                            "(bins are centred on multiples of dm)",
@@ -96,31 +97,6 @@ static int note_or_fail(int rc, const bk_error *inner, char *note, size_t len, b
     if (err)
         *err = *inner;
     return rc;
-}
-
-/* Duration and rates: the run's simulated span when the catalog is a bksim output (runs start
- * at t = 0), else the span of the catalog itself; either clipped to the time window. */
-static void set_duration(bk_stats_report *r, const bk_event_table *t)
-{
-    double start, end;
-    if (isfinite(t->t_reached) && t->t_reached > 0.0 && t->t_reached >= r->t_last) {
-        start = 0.0;
-        end = t->t_reached;
-        r->duration_from_run = 1;
-    } else {
-        start = r->t_first;
-        end = r->t_last;
-        if (t->t_end)
-            for (size_t i = 0; i < t->n; ++i)
-                if (isfinite(t->t_end[i]) && t->t_end[i] > end && isfinite(t->t_start[i]) &&
-                    in_window(&r->options, t->t_start[i]))
-                    end = t->t_end[i];
-    }
-    start = fmax(start, r->options.t_from);
-    end = fmin(end, r->options.t_to);
-    r->span_start = start;
-    r->duration = r->n_events && end > start ? end - start : 0.0;
-    r->rate = r->duration > 0.0 ? (double)r->n_events / r->duration : 0.0;
 }
 
 /* The potency threshold: the potency of the lower edge of the Mc bin when the catalog's
@@ -509,32 +485,27 @@ static int compute_sizes(bk_stats_report *r, const bk_event_table *t, bk_error *
     return note_or_fail(rc, &inner, r->sizes_note, sizeof r->sizes_note, err);
 }
 
-/* Keep the complete rows with a finite start and magnitude inside the time window. */
+/* Keep the rows bk_event_select keeps (complete, finite start and magnitude, in the time
+ * window), their columns copied, and the span they were observed over. */
 static int select_events(bk_stats_report *r, const bk_event_table *t, bk_error *err)
 {
-    size_t n = t->n ? t->n : 1;
+    bk_event_selection sel;
+    int rc = bk_event_select(t, r->options.t_from, r->options.t_to, &sel, err);
+    if (rc != BK_OK)
+        return rc;
+    size_t n = sel.n_events ? sel.n_events : 1;
     r->t_start = malloc(n * sizeof *r->t_start);
     r->magnitude = malloc(n * sizeof *r->magnitude);
     r->potency = t->potency ? malloc(n * sizeof *r->potency) : NULL;
     r->t_end = t->t_end ? malloc(n * sizeof *r->t_end) : NULL;
     r->n_blocks = t->n_blocks ? malloc(n * sizeof *r->n_blocks) : NULL;
     if (!r->t_start || !r->magnitude || (t->potency && !r->potency) || (t->t_end && !r->t_end) ||
-        (t->n_blocks && !r->n_blocks))
+        (t->n_blocks && !r->n_blocks)) {
+        bk_event_selection_free(&sel);
         return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for %zu events", r->path, t->n);
-    for (size_t i = 0; i < t->n; ++i) {
-        if (t->complete && t->complete[i] == 0) {
-            ++r->n_incomplete;
-            continue;
-        }
-        if (!isfinite(t->t_start[i]) || !isfinite(t->magnitude[i])) {
-            ++r->n_nonfinite;
-            continue;
-        }
-        if (!in_window(&r->options, t->t_start[i])) {
-            ++r->n_outside;
-            continue;
-        }
-        size_t k = r->n_events++;
+    }
+    for (size_t k = 0; k < sel.n_events; ++k) {
+        size_t i = sel.index[k];
         r->t_start[k] = t->t_start[i];
         r->magnitude[k] = t->magnitude[i];
         if (r->potency)
@@ -543,15 +514,20 @@ static int select_events(bk_stats_report *r, const bk_event_table *t, bk_error *
             r->t_end[k] = t->t_end[i];
         if (r->n_blocks)
             r->n_blocks[k] = t->n_blocks[i];
-        if (k == 0 || t->t_start[i] < r->t_first)
-            r->t_first = t->t_start[i];
-        if (k == 0 || t->t_start[i] > r->t_last)
-            r->t_last = t->t_start[i];
-        if (k == 0 || t->magnitude[i] < r->m_min)
-            r->m_min = t->magnitude[i];
-        if (k == 0 || t->magnitude[i] > r->m_max)
-            r->m_max = t->magnitude[i];
     }
+    r->n_events = sel.n_events;
+    r->n_incomplete = sel.n_incomplete;
+    r->n_nonfinite = sel.n_nonfinite;
+    r->n_outside = sel.n_outside;
+    r->t_first = sel.t_first;
+    r->t_last = sel.t_last;
+    r->m_min = sel.m_min;
+    r->m_max = sel.m_max;
+    r->span_start = sel.span_start;
+    r->duration = sel.duration;
+    r->duration_from_run = sel.duration_from_run;
+    r->rate = r->duration > 0.0 ? (double)r->n_events / r->duration : 0.0;
+    bk_event_selection_free(&sel);
     return BK_OK;
 }
 
@@ -565,7 +541,6 @@ static int compute(bk_stats_report *r, const bk_event_table *t, bk_error *err)
     int rc = select_events(r, t, err);
     if (rc != BK_OK)
         return rc;
-    set_duration(r, t);
     if ((rc = compute_sizes(r, t, err)) != BK_OK)
         return rc;
     if (!r->has_potency)

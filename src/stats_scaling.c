@@ -6,6 +6,7 @@
  * (two passes) and the residual sum of squares from the residuals themselves, so that an
  * exact power law gives r = 1 and a zero error rather than the rounding of Svv - b Suv. */
 #include "bksim/stats_scaling.h"
+#include "stats_impl.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -130,30 +131,19 @@ void bk_scaling_options_default(bk_scaling_options *opt)
     opt->min_blocks = BK_SCALING_MIN_BLOCKS;
 }
 
-/* The number of bins q = x / dm when it is a whole number to within 1e-6 of a bin (as
- * bksim/stats.h asks of Mc), else 0 with *whole = 0. */
-static long whole_bins(double x, double dm, int *whole)
-{
-    double q = x / dm;
-    *whole = fabs(q) <= 1e15 && fabs(q - floor(q + 0.5)) <= 1e-6;
-    return *whole ? (long)floor(q + 0.5) : 0;
-}
-
 int bk_scaling_options_check(const bk_scaling_options *opt, bk_error *err)
 {
-    int whole = 0;
+    long k = 0;
     if (!(isfinite(opt->dm) && opt->dm > 0.0))
         return BK_FAIL(err, BK_ERR_INVALID, "scaling: magnitude bin width dm = %g: must be finite and > 0", opt->dm);
     if (!isfinite(opt->mc))
         return BK_FAIL(err, BK_ERR_INVALID, "scaling: Mc = %g: must be finite (a bin centre: a multiple of dm = %g)",
                        opt->mc, opt->dm);
-    whole_bins(opt->mc, opt->dm, &whole);
-    if (!whole)
+    if (!bk_stats_centre_bin(opt->mc, opt->dm, &k))
         return BK_FAIL(err, BK_ERR_INVALID,
                        "scaling: Mc = %g is not a bin centre: it must be a multiple of the bin width dm = %g",
                        opt->mc, opt->dm);
-    long w = whole_bins(opt->band_width, opt->dm, &whole);
-    if (!(isfinite(opt->band_width) && whole && w >= 1))
+    if (!(bk_stats_centre_bin(opt->band_width, opt->dm, &k) && k >= 1))
         return BK_FAIL(err, BK_ERR_INVALID,
                        "scaling: band width %g: must be a positive multiple of the bin width dm = %g", opt->band_width,
                        opt->dm);
@@ -252,8 +242,10 @@ int bk_scaling_by_magnitude(const bk_scaling_columns *columns, const bk_scaling_
                        columns->magnitude ? "potency" : "magnitude");
     out->options = *opt;
     out->n_rows = columns->n;
-    int whole = 0;
-    long k_mc = whole_bins(opt->mc, opt->dm, &whole), w = whole_bins(opt->band_width, opt->dm, &whole);
+    /* Both are whole bins: bk_scaling_options_check said so. */
+    long k_mc = 0, w = 0;
+    bk_stats_centre_bin(opt->mc, opt->dm, &k_mc);
+    bk_stats_centre_bin(opt->band_width, opt->dm, &w);
     size_t n = columns->n ? columns->n : 1;
     long *band = malloc(n * sizeof *band);
     double *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y);

@@ -203,11 +203,9 @@ static int centre_bin(double x, double dm, const char *name, long *k, bk_error *
 {
     if (!isfinite(x))
         return BK_FAIL(err, BK_ERR_INVALID, "%s = %g: must be finite", name, x);
-    double r = x / dm;
-    if (!(fabs(r) <= 1e15) || fabs(r - floor(r + 0.5)) > 1e-6)
+    if (!bk_stats_centre_bin(x, dm, k))
         return BK_FAIL(err, BK_ERR_INVALID,
                        "%s = %g is not a bin centre: it must be a multiple of the bin width dm = %g", name, x, dm);
-    *k = (long)floor(r + 0.5);
     return BK_OK;
 }
 

@@ -451,6 +451,23 @@ typedef struct bk_event_table {
 /* Free the columns and zero the table. */
 void bk_event_table_free(bk_event_table *table);
 
+/* The rows every catalog statistic uses (src/stats_select.c): complete (complete != 0 where
+ * the field exists), with a finite t_start and magnitude, starting in [t_from, t_to); the
+ * others counted by why.  The observed span: from t = 0 to the run's t_reached when the table
+ * has one at or after the last kept start, else from the first kept start to the latest
+ * t_end (or start) of a row starting in the window; clipped to the window (0 without rows). */
+typedef struct bk_event_selection {
+    size_t n_events, n_incomplete, n_nonfinite, n_outside;
+    size_t *index;            /* the kept rows, in table order (malloc'ed) */
+    double t_first, t_last;   /* of the kept starts (0 without rows) */
+    double m_min, m_max;      /* of their magnitudes (0 without rows) */
+    double span_start, duration;
+    int duration_from_run;    /* 1: the span is the run's */
+} bk_event_selection;
+int bk_event_select(const bk_event_table *table, double t_from, double t_to, bk_event_selection *out,
+                    bk_error *err);
+void bk_event_selection_free(bk_event_selection *selection);
+
 /* Everything `bksim stats` reports about one catalog.  A statistic the catalog cannot
  * support (too few events above Mc, no potency field...) has have_* = 0 and the reason in
  * its *_note; the report as a whole fails only when the file is no catalog. */
