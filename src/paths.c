@@ -123,6 +123,28 @@ int bk_output_durable_rename(const char *part, const char *path, bk_error *err)
     return BK_OK;
 }
 
+int bk_output_set_aside(const char *part, char **kept, bk_error *err)
+{
+    *kept = NULL;
+    size_t size = strlen(part) + 32;
+    char *name = malloc(size);
+    if (!name)
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", part);
+    struct stat st;
+    snprintf(name, size, "%s.damaged", part);
+    for (int k = 2; lstat(name, &st) == 0 && k < 1000; ++k)
+        snprintf(name, size, "%s.damaged.%d", part, k);
+    if (lstat(name, &st) == 0 || rename(part, name) != 0) {
+        int e = errno;
+        int rc = BK_FAIL(err, BK_ERR_IO, "%s: cannot move it aside to %s: %s", part, name,
+                         lstat(name, &st) == 0 ? "999 earlier copies are there" : strerror(e));
+        free(name);
+        return rc;
+    }
+    *kept = name;
+    return BK_OK;
+}
+
 int bk_output_write_locked(const char *path)
 {
     int fd = open(path, O_RDONLY | O_CLOEXEC);

@@ -75,5 +75,9 @@ int bk_h5_restartable(const char *path, double *t_checkpoint, bk_error *err);
 int bk_output_is_part(const char *path);
 char *bk_output_part_path(const char *path);
 char *bk_output_final_path(const char *path);
+/* Move a .part that cannot be continued out of the way, to "<part>.damaged" (or
+ * "<part>.damaged.2", ... when that exists), so that starting over does not destroy it;
+ * *kept (malloc'd) gets the new name. */
+int bk_output_set_aside(const char *part, char **kept, bk_error *err);
 
 #endif

@@ -66,7 +66,9 @@ static const char *const run_help =
     "  --force            start over even when OUT.part holds a checkpoint to restart from\n"
     "                     (without it, run refuses to overwrite that progress)\n"
     "  --resume           continue OUT.part from its checkpoint when it holds one that\n"
-    "                     verifies, else start over: what a batch script reruns\n"
+    "                     verifies, else start over (a .part whose datasets do not reopen\n"
+    "                     at its checkpoint is kept as OUT.part.damaged): what a batch\n"
+    "                     script reruns\n"
     "  --point NAME       the sweep grid point this run is, recorded in OUT (attribute point)\n"
     "  --strict           refuse (exit 2) a config that draws a warning: a value far outside\n"
     "                     what the others make plausible (see `bksim check --help`)\n"
@@ -340,6 +342,20 @@ static int show_progress(void *user, const bk_progress *r)
     return 0;
 }
 
+/* A new output at path (its .part, written from the start), marked as a sweep's point when
+ * one is given. */
+static int open_new_output(bk_h5_writer **writer, const bk_config *config, const char *path, const char *point,
+                           bk_error *err)
+{
+    int opened = bk_h5_writer_open(writer, config, path, err);
+    if (opened == BK_OK && point && bk_h5_writer_set_point(*writer, point, err) != BK_OK) {
+        bk_h5_writer_abandon(*writer, err->message, NULL);
+        *writer = NULL;
+        opened = BK_ERR_IO;
+    }
+    return opened;
+}
+
 static int cmd_run(int argc, char **argv)
 {
     config_args args;
@@ -390,9 +406,32 @@ static int cmd_run(int argc, char **argv)
                                  "than this command's: pass --force to start over",
                                  path);
             }
+            if (opened == BK_ERR_DAMAGED || opened == BK_ERR_HDF5) {
+                /* A kill inside one of HDF5's flushes can leave a .part whose checkpoint
+                 * verifies but whose datasets no longer reopen at it (a chunk index half
+                 * written).  --resume continues what can be continued and runs the rest:
+                 * the .part is kept aside, never replaced, and the run starts over. */
+                char *part = bk_output_part_path(path), *kept = NULL;
+                bk_error moved = {0};
+                if (!part || bk_output_set_aside(part, &kept, &moved) != BK_OK) {
+                    fprintf(stderr, "%s\n", err.message);
+                    err = moved;
+                } else {
+                    fprintf(stderr, "bksim: starting over: %s cannot be continued (%s); it is kept as %s\n",
+                            part, err.message, kept);
+                    config = given;
+                    given = NULL;
+                    free(restart_path);
+                    restart_path = NULL;
+                    opened = open_new_output(&writer, config, path, args.point, &err);
+                }
+                free(part);
+                free(kept);
+            }
             bk_config_free(given);
-            path = args.restart = restart_path; /* from here on, a restarted run */
-            if (!args.quiet && opened == BK_OK)
+            if (restart_path)
+                path = args.restart = restart_path; /* from here on, a restarted run */
+            if (!args.quiet && opened == BK_OK && args.restart)
                 fprintf(stderr, "bksim: continuing %s.part from its checkpoint t = %.17g s\n", path,
                         t_checkpoint);
         } else if (restartable == 1) {
@@ -411,12 +450,7 @@ static int cmd_run(int argc, char **argv)
                 fprintf(stderr, "bksim: starting over: %s is replaced (%s)\n", part,
                         args.force ? "--force" : "it holds no checkpoint to continue from");
             free(part);
-            opened = bk_h5_writer_open(&writer, config, path, &err);
-            if (opened == BK_OK && args.point && bk_h5_writer_set_point(writer, args.point, &err) != BK_OK) {
-                bk_h5_writer_abandon(writer, err.message, NULL);
-                writer = NULL;
-                opened = BK_ERR_IO;
-            }
+            opened = open_new_output(&writer, config, path, args.point, &err);
         }
     }
     if (opened != BK_OK) {
