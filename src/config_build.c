@@ -371,8 +371,8 @@ static void build_chain(loader *ld, bk_config *c)
         return;
     }
     c->model = m;
-    m->rows = rows;
-    m->cols = cols;
+    m->rows = ld->rows = rows;
+    m->cols = ld->cols = cols;
     m->boundary_cols = boundary_of(ld, "boundary_cols", cols > 1 || rows == 1);
     m->boundary_rows = boundary_of(ld, "boundary_rows", rows > 1);
     m->coupling_stiffness = value_of(ld, "model", "coupling_stiffness");
@@ -382,9 +382,9 @@ static void build_chain(loader *ld, bk_config *c)
     double history = build_driver(ld, m);
 
     /* The block keys' definitions, looked up once rather than per block. */
-    enum { MASS, DRIVER_STIFFNESS, NORMAL_FORCE, X_INIT, X_INIT_RANDOM, V_INIT, DAMPING, N_BLOCK_KEYS };
+    enum { MASS, DRIVER_STIFFNESS, NORMAL_FORCE, X_INIT, X_INIT_RANDOM, V_INIT, DAMPING, APPLIED_FORCE, N_BLOCK_KEYS };
     static const char *const block_keys[N_BLOCK_KEYS] = {"mass", "driver_stiffness", "normal_force", "x_init",
-                                                         "x_init_random", "v_init", "damping"};
+                                                         "x_init_random", "v_init", "damping", "applied_force"};
     const key_def *def[N_BLOCK_KEYS];
     for (size_t k = 0; k < N_BLOCK_KEYS; ++k)
         def[k] = bk_config_find_key("block", block_keys[k]);
@@ -423,6 +423,7 @@ static void build_chain(loader *ld, bk_config *c)
         b->v_init = block_value(ld, i, def[V_INIT], &given);
         int given_v = given;
         b->damping = block_value(ld, i, def[DAMPING], &given);
+        b->applied_force = block_value(ld, i, def[APPLIED_FORCE], &given);
         build_friction(ld, b, i, m->driver.velocity);
         if (b->mass == 0.0 && ld->error_rank == LONG_MAX && !check_quasi_dynamic(ld, m, b, i, given_normal, given_v))
             break; /* one such block is enough */

@@ -86,6 +86,9 @@ static const key_def keys[] = {
         "adds a uniform random displacement in [-a, a] to x_init (heterogeneous chains; [model] seed)"),
     NUM("block", "damping", "N s/m", 0.0, 0.0, INFINITY, 0,
         "dashpot from the block to the substrate, force -damping * v (the radiation damping of quasi-dynamic models)"),
+    NUM("block", "applied_force", "N", 0.0, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
+        "constant tangential force on the block, signed (+: the driver's direction): a prestress; on one end "
+        "block ([block.0]) an edge pushed with a constant force"),
 
     {"friction", {"law", "", NAN, 0, 0, BK_PARAM_REQUIRED, "friction law; its parameters follow in the same section"},
      BK_KEY_CHOICE, NULL, law_name, NULL},
@@ -305,8 +308,13 @@ void bk_config_write_reference(FILE *out)
         "model", "The chain, or the 2D lattice.",
         "block", "Defaults for every block; a `[block.I]` section (I = 0 .. n_blocks-1) overrides them for block I. "
                  "Any numeric key here or in `[friction]` may be a distribution drawn per block at load time from "
-                 "`[model] seed`: `uniform(a, b)`, `normal(mean, sd)` or `lognormal(mu, sigma)` (of the log); a draw "
-                 "outside the key's range is an error naming the block, and every block's value is written to "
+                 "`[model] seed`: `uniform(a, b)`, `normal(mean, sd)` or `lognormal(mu, sigma)` (of the log); or a "
+                 "profile across the blocks: `linear(first, last)` from the first column to the last (a chain's "
+                 "first block to its last), `linear_rows(first, last)` from the first row to the last, or "
+                 "`file(path, column)`: one line per block in block order (row by row on a lattice), columns "
+                 "separated by spaces or tabs, `#` comments and blank lines skipped, the path relative to the "
+                 "config's directory (read again by `--restart`: keep it). A value outside the key's range is an "
+                 "error naming the block (and the file's line), and every block's value is written to "
                  "`/parameters/<section>.<key>`.",
         "friction", "The friction law of every block and its parameters (tables below); `[friction.I]` overrides "
                     "them for block I. A `[friction.I]` naming a different law takes none of `[friction]`'s "

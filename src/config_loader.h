@@ -52,13 +52,27 @@ typedef struct entry {
     long first_of_key;         /* an earlier file entry of the same section and key, or -1 */
     double number;             /* parsed value (numbers, bools, enum index, list length) */
     double *list;              /* BK_KEY_LIST values, owned */
-    /* A value drawn per block (config_random.c): 1 uniform, 2 normal, 3 lognormal; 0 none. */
+    /* A value per block (config_random.c): drawn (BK_DRAW_UNIFORM .. LOGNORMAL) or a profile
+     * (BK_PROFILE_LINEAR, _ROWS, _FILE); 0 (BK_DRAW_NONE) for one value. */
     int distribution;
     double dist_a, dist_b;
+    double *profile;           /* BK_PROFILE_FILE: the column's values, owned, read at the first block */
+    int *profile_lines;        /* and the file line of each, for messages */
+    size_t profile_len;
     void *rng;                 /* the entry's stream (gsl_rng), owned */
     size_t drawn;              /* numbers drawn so far, and the last */
     double last_draw;
 } entry;
+
+enum {
+    BK_DRAW_NONE = 0,
+    BK_DRAW_UNIFORM = 1,
+    BK_DRAW_NORMAL = 2,
+    BK_DRAW_LOGNORMAL = 3,
+    BK_PROFILE_LINEAR = 4,      /* linear(first, last): along a row (a chain's blocks), by column */
+    BK_PROFILE_LINEAR_ROWS = 5, /* linear_rows(first, last): along a column, by row */
+    BK_PROFILE_FILE = 6         /* file(path[, column]): one line per block */
+};
 
 typedef struct loader {
     const char *name;          /* config file name for messages */
@@ -78,6 +92,7 @@ typedef struct loader {
     size_t n_slots;            /* a power of two, at least twice the entries */
     int per_block_sections;    /* any [block.I] or [friction.I] entry: else blocks skip those lookups */
     unsigned long seed;        /* [model] seed, once building begins */
+    size_t rows, cols;         /* the shape, once building begins (profiles need it) */
     bk_block_parameter *parameters; /* keys given as a distribution, until the config takes them */
     size_t n_parameters;
 } loader;
@@ -113,10 +128,11 @@ void bk_config_check_entries(loader *ld, long n_blocks);
 
 /* --- per-block random values (config_random.c) ----------------------------------------- */
 
-/* 1 and the entry set up when its value is a distribution, 0 when it is none, -1 reported. */
+/* 1 and the entry set up when its value is a distribution or a profile, 0 when it is
+ * neither, -1 reported. */
 int bk_config_parse_distribution(loader *ld, entry *e, const bk_param *param, const char *allowed);
-/* The entry's value for block i, drawn (blocks in increasing order); NAN, reported, when the
- * draw falls outside param's range. */
+/* The entry's value for block i, drawn or from its profile (blocks in increasing order);
+ * NAN, reported, when it falls outside param's range (or the profile's file fails). */
 double bk_config_draw(loader *ld, entry *e, size_t block, const bk_param *param);
 void bk_config_free_draws(entry *e);
 /* A /parameters array for every key some entry draws (-1, reported, when out of memory); the

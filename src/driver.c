@@ -39,6 +39,16 @@ void bk_driver_free_history(bk_driver *driver)
     driver->n_segments = 0;
 }
 
+void bk_driver_move_start(bk_driver *driver, double position)
+{
+    double shift = position - driver->start_position;
+    driver->start_position = position;
+    for (size_t k = 0; k < driver->n_segments; ++k)
+        driver->segment_position[k] += shift;
+    if (driver->n_segments > 0)
+        driver->segment_position[0] = position; /* exactly, not by the sum */
+}
+
 size_t bk_driver_segment(const bk_driver *driver, double t)
 {
     size_t n = driver->n_segments;

@@ -295,7 +295,7 @@ static double balance_velocity(const bk_island *island, double t, const double *
     const double *state = block_state(island, y, i);
     double driver_pos = bk_driver_segment_position(&scene->model->driver, island->driver_segment, t);
     double x_i = position(island, y, (long)i);
-    double load = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i);
+    double load = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) + b->applied_force;
     double eta = b->damping;
     double lo = fmin(0.0, load / eta), hi = fmax(0.0, load / eta);
     double v = guess > lo && guess < hi ? guess : 0.5 * (lo + hi);
@@ -516,7 +516,7 @@ static void rhs_parts(const bk_island *island, double t, const double *y, double
         double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
         double dir = (double)scene->mode[i];
         double spring = driver_force(scene, i, x_i, driver_pos);
-        double applied = spring + coupling_force(island, y, i, x_i);
+        double applied = spring + coupling_force(island, y, i, x_i) + b->applied_force;
         double dashpots = damping_force(island, y, i);
         double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
                                                 block_state(island, y, i));
@@ -718,7 +718,7 @@ int bk_island_roots(double t, const double *y, double *g, void *user)
         double *gi = &g[R * k];
         double x_i = position(island, y, (long)i);
         double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) +
-                         damping_force(island, y, i);
+                         b->applied_force + damping_force(island, y, i);
         const double *state = block_state(island, y, i);
         size_t s = scene->slot[i];
         if (!scene->can_stick[i]) {
@@ -757,7 +757,7 @@ double bk_island_slip_acceleration(const bk_island *island, size_t i, double t, 
     double dir = (double)scene->mode[i];
     refresh_ghosts(island, t);
     double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) +
-                     damping_force(island, y, i);
+                     b->applied_force + damping_force(island, y, i);
     double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
                                             block_state(island, y, i));
     if (!(b->mass > 0.0))

@@ -27,6 +27,7 @@ void bk_model_free(bk_model *model)
     if (!model)
         return;
     free(model->blocks);
+    free(model->state_init);
     bk_driver_free_history(&model->driver);
     free(model);
 }
@@ -110,7 +111,8 @@ double bk_model_coupling_force(const bk_model *model, size_t i, const double *x)
 
 double bk_model_applied_force(const bk_model *model, size_t i, const double *x, double driver_pos)
 {
-    return bk_model_driver_force(model, i, x[i], driver_pos) + bk_model_coupling_force(model, i, x);
+    return bk_model_driver_force(model, i, x[i], driver_pos) + bk_model_coupling_force(model, i, x) +
+           model->blocks[i].applied_force;
 }
 
 double bk_model_damping_force(const bk_model *model, size_t i, const double *v)
@@ -146,6 +148,7 @@ double bk_model_elastic_energy(const bk_model *model, const double *x, double dr
     double kc = model->coupling_stiffness;
     double energy = 0.0;
     for (size_t i = 0; i < n; ++i) {
+        energy -= model->blocks[i].applied_force * x[i];
         double extension = driver_pos - x[i];
         if (!(model->spring == BK_SPRING_TENSION_ONLY && extension < 0.0))
             energy += 0.5 * model->blocks[i].driver_stiffness * extension * extension;

@@ -55,6 +55,30 @@ static double sample_time(const run_ctx *ctx, long k)
     return t >= ctx->t_end - 1e-9 * ctx->interval ? ctx->t_end : t;
 }
 
+/* The end is a restart point of a run that has them, written as a checkpoint whatever the wall
+ * clock says: the state a later run starts from (--init-from), and where a longer run of the
+ * same scene goes on (--restart with a later t_end). */
+static int ends_with_checkpoint(const run_ctx *ctx)
+{
+    return ctx->sink && ctx->sink->checkpoint &&
+           (ctx->checkpoint_interval > 0.0 || ctx->checkpoint_work > 0.0);
+}
+
+/* The sample a run continued past t_end emits first: the first on the grid after t_end (a
+ * row at t_end, sample or event, is written now; a grid time the last row stood in for,
+ * within rounding before it, is still to come at its own time). */
+static long next_sample_after_end(const run_ctx *ctx)
+{
+    if (ctx->interval <= 0.0)
+        return 1; /* the only sample left is the end's */
+    double k = floor(ctx->t_end / ctx->interval);
+    while (k * ctx->interval <= ctx->t_end)
+        k += 1.0;
+    while (k > 1.0 && (k - 1.0) * ctx->interval > ctx->t_end)
+        k -= 1.0;
+    return (long)k;
+}
+
 /* Skip a sample that falls exactly on an event row already written. */
 static void skip_sample_at(run_ctx *ctx, double t)
 {
@@ -155,9 +179,14 @@ static int schedule(run_ctx *ctx)
             if ((rc = bk_run_unpack_all(ctx, ctx->t_end)) != BK_OK)
                 return rc;
             /* The final row, unless an event row at t_end took its place. */
-            if (ctx->next_sample >= 0)
+            long after_end = next_sample_after_end(ctx);
+            /* A run resumed from its own end's checkpoint (killed before it finished) has that
+             * row already. */
+            if (ctx->next_sample >= 0 && ctx->t_last_row < ctx->t_end)
                 rc = bk_run_emit_sample(ctx, ctx->t_end);
             ctx->next_sample = -1;
+            if (rc == BK_OK && ends_with_checkpoint(ctx))
+                rc = bk_run_write_checkpoint(ctx, ctx->t_end, after_end);
             return rc;
         }
         if (rc != BK_OK)

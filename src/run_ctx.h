@@ -181,6 +181,9 @@ static inline int bk_compare_blocks(const void *a, const void *b)
  * point (restart_point) the state is first recorded as a checkpoint when the wall-clock
  * interval has passed; otherwise (a driver breakpoint) only the restart. */
 int bk_run_restart_all(run_ctx *ctx, double t, int restart_point);
+/* Write the state at t, every island unpacked there, as a checkpoint through the sink (which
+ * must take them), with next_sample the first sample a continuation emits. */
+int bk_run_write_checkpoint(run_ctx *ctx, double t, long next_sample);
 /* The state of a checkpoint, back into the chain. */
 int bk_run_resume(run_ctx *ctx, const bk_checkpoint *cp);
 /* Statistics so far, the resumed run's included. */

@@ -36,39 +36,45 @@ int bk_run_restart_all(run_ctx *ctx, double t, int restart_point)
     double now = bk_run_wall_seconds();
     if (ctx->sink && ctx->sink->checkpoint && now - ctx->wall_checkpoint >= ctx->checkpoint_wall_interval) {
         ctx->wall_checkpoint = now;
-        bk_scene *scene = &ctx->scene;
-        bk_checkpoint cp = {
-            .t = t,
-            .n_blocks = scene->n,
-            .n_state = ctx->model->n_friction_state,
-            .mode = scene->mode,
-            .x = scene->x,
-            .v = scene->v,
-            .state = scene->state,
-            .t_switch = scene->t_switch,
-            .from_rest = scene->from_rest,
-            .extremum_armed = scene->extremum_armed,
-            .last_transition = ctx->last_transition,
-            .instant_count = ctx->instant_count,
-            .next_sample = ctx->next_sample,
-            .work_driver = ctx->total.work,
-            .dissipation = ctx->total.friction,
-            .damping_dissipation = ctx->total.damping,
-            .elastic_initial = ctx->elastic0,
-            .kinetic_initial = ctx->kinetic0,
-            .t_last_row = ctx->t_last_row,
-            .steps_since_row = ctx->steps_since_row,
-        };
-        if ((rc = bk_run_catalog_save(ctx, &cp.catalog)) != BK_OK)
+        if ((rc = bk_run_write_checkpoint(ctx, t, ctx->next_sample)) != BK_OK)
             return rc;
-        cp.stats = *ctx->stats;
-        bk_run_collect_stats(ctx, &cp.stats, ctx->cpu0);
-        rc = ctx->sink->checkpoint(ctx->sink->self, &cp, ctx->err);
-        if (rc != BK_OK)
-            return rc < 0 ? rc : BK_ERR_SINK;
     }
     /* A checkpoint is a restart of everything, as a resumed run starts. */
     return bk_run_partition_all(ctx, t);
+}
+
+int bk_run_write_checkpoint(run_ctx *ctx, double t, long next_sample)
+{
+    bk_scene *scene = &ctx->scene;
+    bk_checkpoint cp = {
+        .t = t,
+        .n_blocks = scene->n,
+        .n_state = ctx->model->n_friction_state,
+        .mode = scene->mode,
+        .x = scene->x,
+        .v = scene->v,
+        .state = scene->state,
+        .t_switch = scene->t_switch,
+        .from_rest = scene->from_rest,
+        .extremum_armed = scene->extremum_armed,
+        .last_transition = ctx->last_transition,
+        .instant_count = ctx->instant_count,
+        .next_sample = next_sample,
+        .work_driver = ctx->total.work,
+        .dissipation = ctx->total.friction,
+        .damping_dissipation = ctx->total.damping,
+        .elastic_initial = ctx->elastic0,
+        .kinetic_initial = ctx->kinetic0,
+        .t_last_row = ctx->t_last_row,
+        .steps_since_row = ctx->steps_since_row,
+    };
+    int rc = bk_run_catalog_save(ctx, &cp.catalog);
+    if (rc != BK_OK)
+        return rc;
+    cp.stats = *ctx->stats;
+    bk_run_collect_stats(ctx, &cp.stats, ctx->cpu0);
+    rc = ctx->sink->checkpoint(ctx->sink->self, &cp, ctx->err);
+    return rc == BK_OK ? BK_OK : rc < 0 ? rc : BK_ERR_SINK;
 }
 
 int bk_run_resume(run_ctx *ctx, const bk_checkpoint *cp)

@@ -62,6 +62,8 @@ int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
         if (b->law->n_state > scene->max_block_state)
             scene->max_block_state = b->law->n_state;
     }
+    if (model->state_init)
+        memcpy(scene->state, model->state_init, model->n_friction_state * sizeof *scene->state);
     return 0;
 }
 

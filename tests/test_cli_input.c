@@ -305,7 +305,7 @@ static void test_distribution_errors(void **state)
         {"friction.mu_s=normal(0.6, -0.01)", "[friction] mu_s: normal(0.6, -0.01) has a negative width (allowed: sd >= 0)"},
         {"block.mass=uniform(2, 1)", "[block] mass: uniform(2, 1) has a negative width (allowed: a <= b)"},
         {"block.mass=normal(0.01, 1)", "for block "},
-        {"driver.velocity=uniform(1e-3, 2e-3)", "[driver] velocity: a distribution is drawn per block"},
+        {"driver.velocity=uniform(1e-3, 2e-3)", "[driver] velocity: a distribution or profile gives each block its value"},
     };
     char out[512], cmd[2048];
     snprintf(out, sizeof out, "%s/drawn.h5", tmpdir);

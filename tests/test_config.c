@@ -8,6 +8,7 @@
 
 #include "bk_test.h"
 #include "bksim/config.h"
+#include "files.h"
 #include "bksim/run.h"
 
 static const char *const full_config =
@@ -549,7 +550,7 @@ static void test_rejections(void **state)
          "t.ini:1: [modle]: unknown section (allowed: model, block, block.I, friction, friction.I, driver, "
          "solver, output, run; I is a block index from 0)"},
         {"mass = 1\n", "mass = 1\nmas = 2\n",
-         "t.ini:5: [block] mas: unknown key (allowed: mass, driver_stiffness, normal_force, x_init, v_init, x_init_random, damping)"},
+         "t.ini:5: [block] mas: unknown key (allowed: mass, driver_stiffness, normal_force, x_init, v_init, x_init_random, damping, applied_force)"},
         {"mass = 1\n", "mass = 1\nmass = 2\n", "t.ini:5: [block] mass: duplicate key (first set at line 4)"},
         {"n_blocks = 1\n", "", "t.ini: [model] n_blocks: required key missing (allowed: 1 <= n_blocks <= 1000000, an integer)"},
         {"mass = 1\n", "", "t.ini: [block] mass: required key missing (allowed: 0 <= mass < inf kg)"},
@@ -634,11 +635,30 @@ static void test_rejections(void **state)
          "for block 0, outside the allowed range (allowed: 0 <= mass < inf kg; narrow the distribution, or set "
          "that block in [block.0])"},
         {"velocity = 1e-3\n", "velocity = uniform(1e-3, 2e-3)\n",
-         "t.ini:11: [driver] velocity: a distribution is drawn per block: only keys of [block] and [friction] take one"},
+         "t.ini:11: [driver] velocity: a distribution or profile gives each block its value: only keys of [block] "
+         "and [friction] take one"},
         {"mass = 1\n", "mass = normal(1)\n",
-         "t.ini:4: [block] mass: not a distribution: \"normal(1)\" (allowed: uniform(a, b), normal(mean, sd) or "
-         "lognormal(mu, sigma) with finite numbers)"},
+         "t.ini:4: [block] mass: not a distribution or profile: \"normal(1)\" (allowed: uniform(a, b), normal(mean, "
+         "sd), lognormal(mu, sigma), linear(first, last), linear_rows(first, last) with finite numbers, or "
+         "file(path[, column]))"},
         {"mass = 1\n", "mass = normal(1, 0.1) x\n", "t.ini:4: [block] mass: not a distribution"},
+        {"mass = 1\n", "mass = gamma(1, 2)\n",
+         "t.ini:4: [block] mass: unknown distribution or profile \"gamma\" (allowed: uniform(a, b),"},
+        {"mass = 1\n", "mass = Uniform(1, 2)\n", "t.ini:4: [block] mass: unknown distribution or profile \"Uniform\""},
+        /* Profiles. */
+        {"mass = 1\n", "mass = linear(1, -1)\n",
+         "t.ini:4: [block] mass: linear(1, -1) reaches outside the allowed range (allowed: 0 <= mass < inf kg)"},
+        {"mass = 1\n", "mass = linear_rows(1)\n", "t.ini:4: [block] mass: not a distribution or profile"},
+        {"mass = 1\n", "mass = 1\n[block.0]\napplied_force = linear(0, 1)\n",
+         "t.ini:6: [block.0] applied_force: linear(...) is a profile across the blocks: give it in [block], not in "
+         "[block.0]"},
+        {"mass = 1\n", "mass = file(/nonexistent/profile.tsv)\n",
+         "t.ini:4: [block] mass: /nonexistent/profile.tsv: cannot open the profile: No such file or directory"},
+        {"mass = 1\n", "mass = file(/dev/null)\n", "t.ini:4: [block] mass: /dev/null: not a regular file"},
+        {"mass = 1\n", "mass = file(p.tsv, 0)\n", "t.ini:4: [block] mass: not a distribution or profile"},
+        {"mass = 1\n", "mass = file(p.tsv, 2) x\n", "t.ini:4: [block] mass: not a distribution or profile"},
+        {"mass = 1\n", "mass = file()\n", "t.ini:4: [block] mass: not a distribution or profile"},
+        {"mass = 1\n", "mass = 1\napplied_force = 1e400\n", "t.ini:5: [block] applied_force: not a number: \"1e400\" (allowed: -inf < applied_force < inf N)"},
         {"mu_d = 0.5\n", "mu_d = uniform(0.7, 0.8)\n",
          "t.ini:9: [friction] mu_d: must be <= mu_s (0.6), got 0.7"},
         {"mu_d = 0.5\n", "mu_d = uniform(0.7, 0.8)\n", "(drawn for block 0)"},
@@ -956,6 +976,81 @@ static void test_reference(void **state)
     free(buf);
 }
 
+/* Profiles across the blocks: linear() has its ends exactly and equal steps along a chain and
+ * along a lattice's rows (by column), linear_rows() down its columns (by row); file() reads a
+ * column of a file beside the config (comments and blank lines skipped); every block's value
+ * is kept for /parameters; a file's bad line is named with the config's key. */
+#define PROFILE_TAIL "[friction]\nlaw = coulomb\nmu_s = 1\nmu_d = 0\n[driver]\nvelocity = 0\n[run]\nt_end = 1\n"
+static void test_profiles(void **state)
+{
+    (void)state;
+    bk_config *c = load_drawn("[model]\nn_blocks = 5\n[block]\nmass = 1\ndriver_stiffness = 0\n"
+                              "applied_force = linear(-1, 3)\n" PROFILE_TAIL, NULL);
+    for (size_t i = 0; i < 5; ++i)
+        assert_true(c->model->blocks[i].applied_force == (double)i - 1.0);
+    assert_int_equal(c->n_parameters, 1);
+    assert_string_equal(c->parameters[0].name, "block.applied_force");
+    assert_string_equal(c->parameters[0].unit, "N");
+    assert_true(c->parameters[0].values[4] == 3.0);
+    bk_config_free(c);
+
+    c = load_drawn("[model]\nrows = 3\ncols = 4\n[block]\nmass = linear(1, 4)\ndriver_stiffness = 1\n"
+                   "normal_force = linear_rows(10, 30)\n" PROFILE_TAIL, NULL);
+    for (size_t i = 0; i < 12; ++i) {
+        assert_true(c->model->blocks[i].mass == (double)(i % 4) + 1.0);
+        assert_true(c->model->blocks[i].normal_force == 10.0 * (double)(i / 4) + 10.0);
+    }
+    bk_config_free(c);
+
+    char dir[256], path[512], name[512];
+    assert_int_equal(make_temp_dir(dir, sizeof dir, "bksim_profile"), 0);
+    snprintf(path, sizeof path, "%s/mu.tsv", dir);
+    assert_int_equal(write_text(path, "# block\tmu_s\n0\t0.5\n\n1 0.75\n2\t1.0\n# end\n3 0.625\n4 2.5e-1\n"), 0);
+    snprintf(name, sizeof name, "%s/scene.ini", dir);
+    bk_error err = {0};
+    const char *text = "[model]\nn_blocks = 5\n[block]\nmass = 1\ndriver_stiffness = 1\n"
+                       "[friction]\nlaw = coulomb\nmu_s = file(mu.tsv, 2)\nmu_d = 0.2\n[driver]\nvelocity = 0\n"
+                       "[run]\nt_end = 1\n";
+    c = NULL;
+    int rc = bk_config_load_string(text, name, NULL, 0, &c, &err);
+    if (rc != BK_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(rc, BK_OK);
+    const double expected[] = {0.5, 0.75, 1.0, 0.625, 0.25};
+    for (size_t i = 0; i < 5; ++i) {
+        assert_true(c->model->blocks[i].friction_params[0] == expected[i]);
+        assert_true(c->parameters[0].values[i] == expected[i]);
+    }
+    assert_string_equal(c->parameters[0].name, "friction.mu_s");
+    bk_config_free(c);
+
+    /* What is wrong, where: the config's key and the file's line. */
+    const struct {
+        const char *file_text, *message;
+    } bad[] = {
+        {"0 0.5\n1 0.6\n2 x\n3 0.5\n4 0.5\n", "mu.tsv:3: column 2: not a finite number: \"x\""},
+        {"0 0.5\n1\n", "mu.tsv:2: no column 2"},
+        {"0 0.5\n1 0.6\n", "mu.tsv: 2 values in column 2, the scene has 5 blocks"},
+        {"0 0.5\n1 0.6\n2 0.5\n3 0.5\n4 0.5\n5 0.5\n", "mu.tsv:6: more values than the scene's 5 blocks"},
+        {"0 0.5\n1 0.6\n2 0.1\n3 0.5\n4 0.5\n", "[friction] mu_d: must be <= mu_s (0.1), got 0.2"},
+        {"0 0.5\n1 0.6\n# x\n2 -0.5\n3 0.5\n4 0.5\n", "mu.tsv:4: -0.5 for block 2 is outside the allowed range"},
+        {"0 0.5\n1 0.6\n2 inf\n3 0.5\n4 0.5\n", "mu.tsv:3: column 2: not a finite number: \"inf\""},
+    };
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+        assert_int_equal(write_text(path, bad[k].file_text), 0);
+        c = (bk_config *)&c;
+        rc = bk_config_load_string(text, name, NULL, 0, &c, &err);
+        if (rc != BK_ERR_CONFIG || !strstr(err.message, bad[k].message) || !strstr(err.message, "scene.ini:"))
+            print_error("case %zu: rc %d\n got:      %s\n expected: %s\n", k, rc, err.message, bad[k].message);
+        assert_int_equal(rc, BK_ERR_CONFIG);
+        assert_null(c);
+        assert_non_null(strstr(err.message, bad[k].message));
+        assert_non_null(strstr(err.message, "scene.ini:8: [friction] mu_s: ") ||
+                        strstr(err.message, "scene.ini:9: [friction] mu_d: "));
+    }
+    assert_int_equal(remove_tree(dir), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -966,6 +1061,7 @@ int main(void)
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(test_checkpoint_keys),
         cmocka_unit_test(test_distributions),
+        cmocka_unit_test(test_profiles),
         cmocka_unit_test(test_event_rows_auto),
         cmocka_unit_test(test_tolerated_forms),
         cmocka_unit_test(test_rejections),

@@ -711,6 +711,93 @@ static void test_aging_breakaway(void **state)
     bk_config_free(c);
 }
 
+/* --- a constant applied force ---------------------------------------------------------- */
+
+#define APPLIED_SCENE                                                                                  \
+    "[model]\nn_blocks = 8\ncoupling_stiffness = 2e4\n[block]\nmass = 1\ndriver_stiffness = 1e4\n"     \
+    "[block.3]\nx_init = -2e-5\n[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = linear(0.45, 0.55)\n"    \
+    "[driver]\nvelocity = 1e-3\n[run]\nt_end = 1\n[output]\ninterval = 0\n"
+
+static bk_config *applied_config(const char *method, const char *set)
+{
+    char solver[64];
+    snprintf(solver, sizeof solver, "solver.method=%s", method);
+    const char *overrides[] = {solver, "solver.rtol=1e-12", "solver.atol_x=1e-15", set};
+    bk_config *c = NULL;
+    bk_error err = {0};
+    int rc = bk_config_load_string(APPLIED_SCENE, "applied.ini", overrides, 4, &c, &err);
+    if (rc != BK_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(rc, BK_OK);
+    return c;
+}
+
+/* With equal driver springs k, a constant force F on every block is the driver moved ahead by
+ * F / k: the same transitions at the same times (over 1 s: the chain is chaotic, and later the
+ * two roundings part, 1e-8 s apart by 2 s), and the energy balance still closes (the
+ * force's potential -F x counts with the elastic energy).  Alone, a force above a block's
+ * threshold starts it at t = 0 and one below never moves it. */
+static void test_applied_force(void **state)
+{
+    (void)state;
+    const char *methods[] = {"exact", "gsl_rk8pd", "cvode_bdf"};
+    const double tolerance[] = {1e-11, 1e-9, 1e-7};
+    for (size_t m = 0; m < sizeof methods / sizeof *methods; ++m) {
+        bk_config *pushed = applied_config(methods[m], "block.applied_force=1.5");
+        bk_config *ahead = applied_config(methods[m], "driver.start_position=1.5e-4");
+        recorder a = {0}, b = {0};
+        bk_run_stats stats_a, stats_b;
+        bk_error err = {0};
+        assert_int_equal(run_recorded(pushed, &a, &stats_a, &err), BK_OK);
+        assert_int_equal(run_recorded(ahead, &b, &stats_b, &err), BK_OK);
+        double worst = 0.0;
+        assert_int_equal(a.n_transitions, b.n_transitions);
+        for (size_t k = 0; k < a.n_transitions; ++k) {
+            assert_int_equal(a.transitions[k].block, b.transitions[k].block);
+            assert_int_equal(a.transitions[k].to, b.transitions[k].to);
+            worst = fmax(worst, fabs(a.transitions[k].t - b.transitions[k].t));
+        }
+        print_message("%s: %zu transitions, largest time difference %.3g s; energy residual %.3g J (work %.3g J)\n",
+                      methods[m], a.n_transitions, worst, stats_a.energy_residual, stats_a.work_driver);
+        assert_true(a.n_transitions > 16);
+        assert_true(worst <= tolerance[m]);
+        assert_true(fabs(stats_a.energy_residual) <= 1e-6 * stats_a.work_driver);
+        assert_true(a.max_balance_error <= 1e-6 * stats_a.work_driver);
+        recorder_free(&a);
+        recorder_free(&b);
+        bk_config_free(pushed);
+        bk_config_free(ahead);
+    }
+
+    /* No driver: 6 N against a threshold of 0.6 * 9.81 = 5.886 N breaks away at once; 5.8 N
+     * holds for ever. */
+    const double forces[] = {6.0, 5.8};
+    for (size_t k = 0; k < 2; ++k) {
+        char set[64];
+        snprintf(set, sizeof set, "block.applied_force=%g", forces[k]);
+        bk_config *c = applied_config("exact", set);
+        c->model->blocks[3].x_init = 0.0;
+        for (size_t i = 0; i < c->model->n_blocks; ++i)
+            c->model->blocks[i].driver_stiffness = 0.0;
+        c->model->coupling_stiffness = 0.0;
+        recorder r = {0};
+        bk_run_stats stats;
+        bk_error err = {0};
+        assert_int_equal(run_recorded(c, &r, &stats, &err), BK_OK);
+        if (k == 0) {
+            assert_int_equal(r.n_transitions, 8);
+            for (size_t j = 0; j < 8; ++j) {
+                assert_true(r.transitions[j].t == 0.0);
+                assert_int_equal(r.transitions[j].to, BK_MODE_SLIP_POS);
+            }
+        } else {
+            assert_int_equal(r.n_transitions, 0);
+        }
+        recorder_free(&r);
+        bk_config_free(c);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -738,6 +825,7 @@ int main(void)
         cmocka_unit_test(test_counters_outlive_instances),
         cmocka_unit_test(test_output_limit_counts_event_rows),
         cmocka_unit_test(test_aging_breakaway),
+        cmocka_unit_test(test_applied_force),
     };
     return cmocka_run_group_tests_name("run", tests, NULL, NULL);
 }

@@ -1,8 +1,10 @@
 /* The scripts under scripts/ end to end, as a user runs them: summary.sh, the paper's plot
- * scripts, the catalogs' (event_ruptures.sh, plot_mfd.sh, plot_slip_map.sh, plot_ruptures.sh)
+ * scripts, the catalogs' (event_ruptures.sh, plot_mfd.sh, plot_slip_map.sh, plot_ruptures.sh),
+ * the fronts' (plot_fronts.sh, front_phase_diagram.sh, with bksim fronts)
  * and the benchmarks' smoke runs (bench.sh --quick, bench_output.sh --quick); sweep.sh is
  * test_sweep.c's.  Runs from the repository root, with ./bksim (or $BKSIM). */
 #define _POSIX_C_SOURCE 200809L
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -356,6 +358,87 @@ static void test_bench_output_smoke(void **state)
     assert_int_equal(system(cmd), 0);
 }
 
+/* bksim fronts and plot_fronts.sh on the shipped 30-block side-driven chain (0.4 s): the
+ * precursor table in order of start, the first crossing at an edge force near N mu_d N, one
+ * front block by block, the three figures; the phase-diagram script on a 2 x 2 grid; what is
+ * refused. */
+static void test_front_scripts(void **state)
+{
+    (void)state;
+    char out[512], figs[512], cmd[2048], expected[700];
+    snprintf(out, sizeof out, "%s/precursors.h5", tmpdir);
+    snprintf(figs, sizeof figs, "%s/front_figs", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run configs/fronts/precursors_30.ini -q -o %s && ./bksim fronts %s", out, out);
+    char *text = NULL;
+    assert_int_equal(run_command(cmd, &text), 0);
+    snprintf(expected, sizeof expected, "# fronts of %s (30 blocks), loaded edge left\n# rupture[1]\tt_start[s]\t"
+             "edge_force[N]\tfirst_block[1]\tn_blocks[1]\tarrest_length[blocks]\tfrom_edge[1]\tcrossed[1]\t"
+             "mean_speed[blocks/s]\tduration[s]\n", out);
+    assert_non_null(strstr(text, expected));
+    /* The first row to cross: its edge force (column 3) and t_start in order. */
+    double previous = -1.0, first_cross = NAN;
+    int rows = 0;
+    for (char *line = strtok(text, "\n"); line; line = strtok(NULL, "\n")) {
+        if (line[0] == '#')
+            continue;
+        long k;
+        double t, force;
+        int first, n, length, from_edge, crossed;
+        assert_int_equal(sscanf(line, "%ld %lf %lf %d %d %d %d %d", &k, &t, &force, &first, &n, &length, &from_edge,
+                                &crossed), 8);
+        assert_true(t >= previous);
+        previous = t;
+        ++rows;
+        if (crossed && isnan(first_cross)) {
+            first_cross = force;
+            assert_int_equal(length, 30);
+        }
+    }
+    free(text);
+    print_message("%d ruptures; the first crossing at an edge force of %.3f N (30 mu_d N = 12 N)\n", rows, first_cross);
+    assert_true(rows > 100 && fabs(first_cross - 12.0) < 0.15 * 12.0);
+    snprintf(cmd, sizeof cmd, "./bksim fronts %s --rupture 0 --window 4", out);
+    expect_command(cmd, 0, "# block[1]\tdistance[blocks]\tt_onset[s]\tt_stop[s]\tslip[m]\tspeed[blocks/s]\n0\t0\t");
+    snprintf(cmd, sizeof cmd, "BKSIM=./bksim scripts/plot_fronts.sh --kinetic 0.4 -o %s %s", figs, out);
+    assert_int_equal(run_command(cmd, &text), 0);
+    const char *names[] = {"precursors_precursors.png", "precursors_fronts.png"};
+    for (size_t k = 0; k < 2; ++k) {
+        char path[700];
+        snprintf(path, sizeof path, "%s/%s", figs, names[k]);
+        assert_non_null(strstr(text, path));
+        assert_true(path_exists(path));
+    }
+    assert_non_null(strstr(text, "_speed.png"));
+    free(text);
+
+    /* Refused: a bad option or value, a rupture past the table, a lattice, no catalog. */
+    snprintf(cmd, sizeof cmd, "./bksim fronts %s --edge top", out);
+    expect_command(cmd, 2, "--edge top: allowed: left, right");
+    snprintf(cmd, sizeof cmd, "./bksim fronts %s --window 1", out);
+    expect_command(cmd, 2, "--window 1: not a whole number >= 2");
+    snprintf(cmd, sizeof cmd, "./bksim fronts %s --rupture 100000", out);
+    expect_command(cmd, 2, "--rupture 100000: it holds");
+    snprintf(cmd, sizeof cmd, "./bksim fronts %s/none.h5", tmpdir);
+    expect_command(cmd, 2, "none.h5: no such HDF5 file");
+    char sheet[300], long_cmd[4096];
+    snprintf(sheet, sizeof sheet, "%s/sheet_fronts", tmpdir);
+    snprintf(long_cmd, sizeof long_cmd, "printf '%%s' '%s' > %s.ini && ./bksim run %s.ini -q -o %s.h5 && ./bksim fronts %s.h5",
+             sheet_ini, sheet, sheet, sheet, sheet);
+    expect_command(long_cmd, 2, "fronts are measured along a chain (one row of blocks); this is a lattice");
+    snprintf(cmd, sizeof cmd, "BKSIM=./bksim scripts/plot_fronts.sh --kinetic -1 %s", out);
+    expect_command(cmd, 2, "--kinetic needs a force > 0 N, got '-1'");
+
+    /* The phase diagram's script on four points of the Oslo model. */
+    snprintf(cmd, sizeof cmd, "BKSIM=./bksim scripts/front_phase_diagram.sh -j 2 -o %s/phase --taus 0.5,0.95 "
+             "--alphas 0.01,1 2>/dev/null", tmpdir);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_non_null(strstr(text, "# tau_bar\talpha\tspeed[blocks/unit time]\treached[blocks]\tbeta\tclass\n"));
+    assert_non_null(strstr(text, "0.95\t0.01\t3.2"));
+    assert_non_null(strstr(text, "supershear"));
+    assert_non_null(strstr(text, "/phase/phase_beta.png"));
+    free(text);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -363,6 +446,7 @@ int main(void)
         cmocka_unit_test(test_plot_scripts),
         cmocka_unit_test(test_catalog_scripts),
         cmocka_unit_test(test_rupture_scripts),
+        cmocka_unit_test(test_front_scripts),
         cmocka_unit_test(test_bench_smoke),
         cmocka_unit_test(test_bench_output_smoke),
     };

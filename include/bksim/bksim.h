@@ -9,6 +9,7 @@
 #include "bksim/config.h"
 #include "bksim/driver.h"
 #include "bksim/friction.h"
+#include "bksim/fronts.h"
 #include "bksim/inspect.h"
 #include "bksim/model.h"
 #include "bksim/modes.h"

@@ -25,6 +25,8 @@ typedef struct bk_driver {
 int bk_driver_set_history(bk_driver *driver, const double *velocities, const double *durations, size_t n);
 /* Release a history (the driver keeps moving at velocity). */
 void bk_driver_free_history(bk_driver *driver);
+/* Move the whole schedule so that D(0) = position (a history's segment positions with it). */
+void bk_driver_move_start(bk_driver *driver, double position);
 
 /* The segment holding t (the later one at a breakpoint; 0 without a history). */
 size_t bk_driver_segment(const bk_driver *driver, double t);

@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include "bksim/config.h"
 #include "bksim/sink.h"
 #include "bksim/stats.h"
 #include "bksim/status.h"
@@ -62,6 +63,9 @@ int bk_h5_export_table(const char *path, const char *table, FILE *out, bk_error 
  * *data is malloc'ed. */
 int bk_h5_read_doubles(const char *path, const char *dataset, double **data, size_t *rows,
                        size_t *cols, bk_error *err);
+/* The config the run in path ran (its stored file text and --set overrides), loaded again;
+ * free it with bk_config_free. */
+int bk_h5_read_config(const char *path, bk_config **config, bk_error *err);
 /* Read /transitions; *rows malloc'ed. */
 int bk_h5_read_transitions(const char *path, bk_transition **rows, size_t *count,
                            bk_error *err);

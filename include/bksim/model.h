@@ -5,6 +5,7 @@
  *   m_i x_i'' = F_i(x, D(t)) + G_i(v) - s_i f_i
  *   F_i = k_i (D - x_i)          driver spring (tension_only: k_i max(0, D - x_i))
  *       + sum_j kc (x_j - x_i)   coupling to the neighbours j (left, right, up, down)
+ *       + a_i                    a constant applied force (prestress, an edge pushed)
  *   G_i = -eta_i v_i             dashpot to the substrate (radiation damping)
  *       + sum_j etac (v_j - v_i) dashpots beside the coupling springs
  *
@@ -40,6 +41,7 @@ typedef struct bk_block {
     double x_init;           /* m, initial displacement; default 0 */
     double v_init;           /* m/s, initial velocity; default 0 */
     double damping;          /* N s/m, >= 0: dashpot to the substrate, force -damping * v */
+    double applied_force;    /* N, signed: a constant tangential force (prestress); default 0 */
     const bk_friction_law *law;
     double friction_params[BK_FRICTION_MAX_PARAMS]; /* in law->params order */
     size_t state_offset;     /* first friction state of this block in the model's state array */
@@ -60,6 +62,9 @@ typedef struct bk_model {
     bk_driver driver;
     bk_block *blocks;          /* n_blocks entries, owned */
     size_t n_friction_state;   /* sum of the blocks' law->n_state */
+    /* The friction states at t = 0 (n_friction_state, owned), or NULL: each law's own
+     * initial state from its parameters.  Set by a run started from another's end. */
+    double *state_init;
 } bk_model;
 
 /* Allocate a model of n blocks, zeroed, a chain (1 x n, free ends); NULL on allocation
@@ -73,14 +78,16 @@ void bk_model_finalize(bk_model *model);
 double bk_model_driver_force(const bk_model *model, size_t i, double x_i, double driver_pos);
 /* Coupling-spring force on block i for positions x (N). */
 double bk_model_coupling_force(const bk_model *model, size_t i, const double *x);
-/* Spring force on block i: driver + coupling (N); bk_model_damping_force adds the dashpots. */
+/* Force on block i from its springs and its constant applied force: driver + coupling +
+ * applied_force (N); bk_model_damping_force adds the dashpots. */
 double bk_model_applied_force(const bk_model *model, size_t i, const double *x, double driver_pos);
 /* Dashpot force on block i for velocities v (N): its own damping and the coupling dashpots
  * (a fixed wall stands still). */
 double bk_model_damping_force(const bk_model *model, size_t i, const double *v);
 /* Some block has damping or the coupling springs have dashpots: the motion depends on v. */
 int bk_model_is_damped(const bk_model *model);
-/* Elastic energy stored in all springs (J). */
+/* Potential energy (J): the elastic energy stored in all springs, and the constant applied
+ * forces' potential -sum a_i x_i (so that the energy balance holds with them). */
 double bk_model_elastic_energy(const bk_model *model, const double *x, double driver_pos);
 /* Kinetic energy (J). */
 double bk_model_kinetic_energy(const bk_model *model, const double *v);

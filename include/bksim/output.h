@@ -37,6 +37,8 @@ int bk_h5_writer_open(bk_h5_writer **out, const bk_config *config, const char *p
                       bk_error *err);
 /* Record the name of the sweep grid point this run is (root attribute `point`). */
 int bk_h5_writer_set_point(bk_h5_writer *writer, const char *point, bk_error *err);
+/* Record (root attribute init_from) the finished run whose end this run started from. */
+int bk_h5_writer_set_init_from(bk_h5_writer *writer, const char *source, double t_source, bk_error *err);
 /* The sink that appends to this writer. */
 bk_sink bk_h5_writer_sink(bk_h5_writer *writer);
 /* Flush, write stats, set complete = 1, close and rename "<path>.part" to <path>.
@@ -68,6 +70,19 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
  * use); negative with err filled only for a missing path or lack of memory.  Meant for
  * refusing to overwrite restartable work. */
 int bk_h5_restartable(const char *path, double *t_checkpoint, bk_error *err);
+
+/* Make the run in path (finished: OUT, or stopped: OUT.part) longer, to t_end: checked
+ * (later than its own t_end, which goes to *old_t_end; the stored config loads with it; a
+ * checkpoint to continue from), stored as one more --set override, and a finished OUT
+ * renamed to OUT.part; bk_h5_writer_resume then continues it.  Nothing is changed on
+ * failure (BK_ERR_INVALID or BK_ERR_CONFIG say why). */
+int bk_h5_extend_to(const char *path, double t_end, double *old_t_end, bk_error *err);
+
+/* The state the finished run in path ended in (its checkpoint at t_end, written by every run
+ * that has restart points), and the config it ran (free both: bk_checkpoint_free,
+ * bk_config_free).  BK_ERR_INVALID says why a file gives none: missing, a .part, not a
+ * finished bksim output, or no checkpoint at its end. */
+int bk_h5_read_end_state(const char *path, bk_checkpoint *end, bk_config **config, bk_error *err);
 
 /* While a run writes OUT it is "OUT.part".  bk_output_is_part: whether path ends in
  * ".part"; bk_output_part_path: path + ".part"; bk_output_final_path: path without its

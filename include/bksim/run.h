@@ -19,4 +19,11 @@ int bk_run(const bk_config *config, const bk_sink *sink, bk_run_stats *stats,
 int bk_run_from(const bk_config *config, const bk_checkpoint *from, const bk_sink *sink,
                 bk_run_stats *stats, bk_progress_fn progress, void *progress_user, bk_error *err);
 
+/* Start config's run where another ended (src/run_start.c): end is the state of a run of
+ * source at its end (bk_h5_read_end_state), and becomes config's state at t = 0 (the blocks'
+ * x_init, v_init and friction states, the driver's start position; modes follow from them
+ * as at any start).  The two must have the same shape and the same law on every block;
+ * BK_ERR_INVALID says what differs, config unchanged. */
+int bk_config_start_from(bk_config *config, const bk_config *source, const bk_checkpoint *end, bk_error *err);
+
 #endif

@@ -21,4 +21,8 @@ int bk_cli_stats(int argc, char **argv);
 int bk_cli_compare(int argc, char **argv);
 int bk_cli_summary(int argc, char **argv);
 
+/* ---- fronts_command.c ---- */
+/* bksim fronts with its arguments (after the command word); the exit status. */
+int bk_cli_fronts(int argc, char **argv);
+
 #endif

@@ -25,8 +25,9 @@ static const char *const usage_text =
     "  run CONFIG [-o OUT] [--set section.key=value]... [--quiet] [--force|--resume]\n"
     "                       simulate the scene CONFIG describes, write HDF5 to OUT\n"
     "                       (default: [output] path)\n"
-    "  run --restart OUT.h5[.part] [--quiet]\n"
-    "                       continue a stopped run from its last checkpoint\n"
+    "  run --restart OUT.h5[.part] [--set run.t_end=T] [--quiet]\n"
+    "                       continue a stopped run from its last checkpoint, or a\n"
+    "                       finished or stopped one to a later t_end\n"
     "  check CONFIG [--set section.key=value]... [--strict]\n"
     "                       validate CONFIG without running\n"
     "  info OUT.h5 [--blocks]\n"
@@ -45,6 +46,9 @@ static const char *const usage_text =
     "  summary DIR [--table NAME] [--mc auto|VALUE] [--bin DM] [--from T] [--to T]\n"
     "                       one row per finished run in DIR (a sweep): its --set values\n"
     "                       and headline figures, as DIR/summary.tsv and DIR/summary.h5\n"
+    "  fronts FILE [--edge left|right] [--rupture K] [--window W] [--min-blocks N]\n"
+    "                       fronts on a chain loaded from one edge: arrest length, edge\n"
+    "                       force and speed per rupture (precursors), or one front\n"
     "  keys                 print the config key reference (Markdown)\n"
     "  --version            print the version\n"
     "\n"
@@ -52,13 +56,16 @@ static const char *const usage_text =
 
 static const char *const run_help =
     "usage: bksim run CONFIG [-o OUT] [--set section.key=value]... [--quiet] [--force|--resume]\n"
-    "                 [--point NAME] [--strict]\n"
-    "       bksim run --restart OUT.h5[.part] [--quiet]\n"
+    "                 [--point NAME] [--strict] [--init-from DONE.h5]\n"
+    "       bksim run --restart OUT.h5[.part] [--set run.t_end=T] [--quiet]\n"
     "\n"
     "Runs the scene described by the INI file CONFIG and writes an HDF5 time series.\n"
     "  --restart OUT      continue the stopped run whose output is OUT.part from its last\n"
     "                     checkpoint ([output] checkpoint_interval), with the config stored\n"
-    "                     in the file; rows after the checkpoint are recomputed\n"
+    "                     in the file; rows after the checkpoint are recomputed.  With\n"
+    "                     --set run.t_end=T (the one --set it takes) a finished or stopped\n"
+    "                     run goes on to a later T: OUT becomes OUT.part again, continued\n"
+    "                     from its last checkpoint (a finished run's is at its end)\n"
     "  -o, --output OUT   output path (overrides [output] path)\n"
     "  --set S.K=V        override key K of section S after reading CONFIG; S may be\n"
     "                     block.3 or friction.3 for one block (repeatable)\n"
@@ -70,6 +77,10 @@ static const char *const run_help =
     "                     at its checkpoint is kept as OUT.part.damaged): what a batch\n"
     "                     script reruns\n"
     "  --point NAME       the sweep grid point this run is, recorded in OUT (attribute point)\n"
+    "  --init-from DONE   start where the finished run DONE.h5 ended: its blocks' positions,\n"
+    "                     velocities and friction states and its driver's position become\n"
+    "                     this run's at t = 0 (same shape and laws; a loading phase, then a\n"
+    "                     rupture phase with other keys); recorded in OUT (attribute init_from)\n"
     "  --strict           refuse (exit 2) a config that draws a warning: a value far outside\n"
     "                     what the others make plausible (see `bksim check --help`)\n"
     "The file is written as OUT.part and renamed to OUT when the run completes; a failed\n"
@@ -142,6 +153,7 @@ typedef struct config_args {
     const char **overrides;
     size_t n_overrides;
     const char *point;
+    const char *init_from;
     int quiet;
     int force;
     int resume;
@@ -181,6 +193,10 @@ static int parse_config_args(const char *command, int argc, char **argv, config_
             if (i + 1 >= argc || !argv[i + 1][0])
                 return bk_cli_usage_error(command, "%s needs a name", a);
             args->point = argv[++i];
+        } else if (allow_output && strcmp(a, "--init-from") == 0) {
+            if (i + 1 >= argc || !argv[i + 1][0])
+                return bk_cli_usage_error(command, "%s needs the output file of a finished run", a);
+            args->init_from = argv[++i];
         } else if (allow_output && strcmp(a, "--restart") == 0) {
             if (i + 1 >= argc)
                 return bk_cli_usage_error(command, "%s needs the output file of the stopped run", a);
@@ -194,11 +210,13 @@ static int parse_config_args(const char *command, int argc, char **argv, config_
         }
     }
     if (args->restart) {
-        if (args->config_path || args->n_overrides || args->output || args->point || args->resume ||
-            args->strict)
-            return bk_cli_usage_error(command, "%s", "--restart takes no CONFIG, -o, --set, --point, "
-                                              "--resume or --strict: the run continues with the "
-                                              "config stored in its file");
+        /* One change only: a later end. */
+        int longer = args->n_overrides == 1 && strncmp(args->overrides[0], "run.t_end=", 10) == 0;
+        if (args->config_path || (args->n_overrides && !longer) || args->output || args->point || args->resume ||
+            args->strict || args->init_from)
+            return bk_cli_usage_error(command, "%s", "--restart takes no CONFIG, -o, --point, --resume, "
+                                              "--init-from or --strict, and no --set but run.t_end=T (a "
+                                              "later end): the run continues with the config stored in its file");
         return 0;
     }
     if (args->force && args->resume)
@@ -342,18 +360,68 @@ static int show_progress(void *user, const bk_progress *r)
     return 0;
 }
 
-/* A new output at path (its .part, written from the start), marked as a sweep's point when
- * one is given. */
+/* Where a run started from (--init-from): the file and the time of its end. */
+typedef struct start_record {
+    const char *path;
+    double t;
+} start_record;
+
+/* A new output at path (its .part, written from the start), marked as a sweep's point and
+ * with the run it started from when there are. */
 static int open_new_output(bk_h5_writer **writer, const bk_config *config, const char *path, const char *point,
-                           bk_error *err)
+                           const start_record *start, bk_error *err)
 {
     int opened = bk_h5_writer_open(writer, config, path, err);
-    if (opened == BK_OK && point && bk_h5_writer_set_point(*writer, point, err) != BK_OK) {
+    if (opened == BK_OK && ((point && bk_h5_writer_set_point(*writer, point, err) != BK_OK) ||
+                            (start->path && bk_h5_writer_set_init_from(*writer, start->path, start->t, err) != BK_OK))) {
         bk_h5_writer_abandon(*writer, err->message, NULL);
         *writer = NULL;
         opened = BK_ERR_IO;
     }
     return opened;
+}
+
+/* --init-from: config starts where the finished run in source ended.  0, or an exit status
+ * after saying why not. */
+static int start_from(bk_config *config, const char *source, int quiet, start_record *start)
+{
+    bk_error err = {0};
+    bk_checkpoint end;
+    bk_config *from = NULL;
+    int rc = bk_h5_read_end_state(source, &end, &from, &err);
+    if (rc == BK_OK) {
+        rc = bk_config_start_from(config, from, &end, &err);
+        if (rc == BK_OK) {
+            start->path = source;
+            start->t = end.t;
+            if (!quiet)
+                fprintf(stderr, "bksim: starting from the end of %s (t = %.17g s): its blocks' positions, velocities "
+                                "and friction states and its driver's position; %s's [block] x_init, v_init and "
+                                "[driver] start_position are not used\n",
+                        source, end.t, config->source_name);
+        }
+        bk_checkpoint_free(&end);
+        bk_config_free(from);
+    }
+    if (rc == BK_OK)
+        return 0;
+    fprintf(stderr, "bksim run --init-from %s: %s\n", source, err.message);
+    return rc == BK_ERR_INVALID || rc == BK_ERR_CONFIG ? EXIT_USAGE : EXIT_RUN_FAILED;
+}
+
+/* --restart OUT --set run.t_end=T: the run made longer first. */
+static int extend_run(const char *path, const char *setting, int quiet, bk_error *err)
+{
+    const char *value = setting + strlen("run.t_end=");
+    char *end = NULL;
+    double t_end = strtod(value, &end);
+    if (end == value || *end || !isfinite(t_end))
+        return BK_FAIL(err, BK_ERR_INVALID, "--set %s: [run] t_end: not a number", setting);
+    double before = 0.0;
+    int rc = bk_h5_extend_to(path, t_end, &before, err);
+    if (rc == BK_OK && !quiet)
+        fprintf(stderr, "bksim: %s: t_end %.17g s -> %.17g s\n", path, before, t_end);
+    return rc;
 }
 
 static int cmd_run(int argc, char **argv)
@@ -374,8 +442,16 @@ static int cmd_run(int argc, char **argv)
     const char *path = args.output ? args.output : config ? config->output.path : NULL;
     char *restart_path = NULL;
     int opened;
+    start_record start = {NULL, 0.0};
+    if (args.init_from && (status = start_from(config, args.init_from, args.quiet, &start)) != 0) {
+        bk_config_free(config);
+        free(args.overrides);
+        return status;
+    }
     if (args.restart) {
-        opened = bk_h5_writer_resume(&writer, args.restart, &config, &checkpoint, &err);
+        opened = args.n_overrides ? extend_run(args.restart, args.overrides[0], args.quiet, &err) : BK_OK;
+        if (opened == BK_OK)
+            opened = bk_h5_writer_resume(&writer, args.restart, &config, &checkpoint, &err);
         restart_path = bk_output_final_path(args.restart);
         path = restart_path;
     } else {
@@ -423,7 +499,7 @@ static int cmd_run(int argc, char **argv)
                     given = NULL;
                     free(restart_path);
                     restart_path = NULL;
-                    opened = open_new_output(&writer, config, path, args.point, &err);
+                    opened = open_new_output(&writer, config, path, args.point, &start, &err);
                 }
                 free(part);
                 free(kept);
@@ -450,7 +526,7 @@ static int cmd_run(int argc, char **argv)
                 fprintf(stderr, "bksim: starting over: %s is replaced (%s)\n", part,
                         args.force ? "--force" : "it holds no checkpoint to continue from");
             free(part);
-            opened = open_new_output(&writer, config, path, args.point, &err);
+            opened = open_new_output(&writer, config, path, args.point, &start, &err);
         }
     }
     if (opened != BK_OK) {
@@ -561,6 +637,8 @@ int main(int argc, char **argv)
         return bk_cli_compare(rest, rest_argv);
     if (strcmp(command, "summary") == 0)
         return bk_cli_summary(rest, rest_argv);
+    if (strcmp(command, "fronts") == 0)
+        return bk_cli_fronts(rest, rest_argv);
     if (strcmp(command, "keys") == 0) {
         if (bk_cli_wants_help(rest, rest_argv)) {
             fputs(keys_help, stdout);

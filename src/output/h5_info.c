@@ -341,6 +341,7 @@ int bk_h5_info_blocks(const char *path, FILE *out, int per_block, bk_error *err)
     char *error = bk_h5_read_string_attr(file, "error");
     char *host = bk_h5_read_string_attr(file, "host");
     char *point = bk_h5_read_string_attr(file, "point");
+    char *init_from = bk_h5_read_string_attr(file, "init_from");
     long long seed = -1;
     int have_seed = H5Aexists(file, "seed") > 0 &&
                     bk_h5_read_numeric_attr(file, "seed", H5T_NATIVE_LLONG, &seed) >= 0;
@@ -366,6 +367,8 @@ int bk_h5_info_blocks(const char *path, FILE *out, int per_block, bk_error *err)
         fprintf(out, "seed         %lld\n", seed);
     if (point)
         fprintf(out, "point        %s\n", point);
+    if (init_from)
+        fprintf(out, "started from %s\n", init_from);
     if (have_complete)
         fprintf(out, "complete     %d%s\n", complete, complete ? "" : " (run did not finish)");
     else
@@ -446,6 +449,7 @@ int bk_h5_info_blocks(const char *path, FILE *out, int per_block, bk_error *err)
     free(error);
     free(host);
     free(point);
+    free(init_from);
     free(stick);
     free(slip);
     bk_h5_close_id(file);

@@ -381,6 +381,20 @@ int bk_h5_require_datasets(hid_t file, const char *path, const char *names, bk_e
     return BK_OK;
 }
 
+int bk_h5_read_config(const char *path, bk_config **config, bk_error *err)
+{
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    *config = NULL;
+    if (bk_h5_has_signature(path) <= 0)
+        return BK_FAIL(err, BK_ERR_INVALID, "%s: no such HDF5 file", path);
+    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (file < 0)
+        return H5_FAIL(err, "%s: cannot open", path);
+    int rc = bk_h5_load_stored_config(file, path, config, err);
+    bk_h5_close_id(file);
+    return rc;
+}
+
 /* The config a run stored (file text and --set overrides, any number of them). */
 int bk_h5_load_stored_config(hid_t file, const char *path, bk_config **config, bk_error *err)
 {

@@ -71,9 +71,10 @@ static int write_parameters(bk_h5_writer *w, const bk_config *config, bk_error *
         hid_t dset = space >= 0 ? H5Dcreate2(group, p->name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT,
                                              H5P_DEFAULT)
                                 : -1;
-        char description[BK_PARAMETER_NAME_LEN + 192];
-        snprintf(description, sizeof description, "the value of %s of every block, drawn at load time from "
-                 "[model] seed where the config gives a distribution (NaN: the block's law has no such key)",
+        char description[BK_PARAMETER_NAME_LEN + 256];
+        snprintf(description, sizeof description, "the value of %s of every block, where the config gives a "
+                 "distribution (drawn at load time from [model] seed) or a profile (linear, file) (NaN: the "
+                 "block's law has no such key)",
                  p->name);
         if (dset < 0 || H5Dwrite(dset, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, p->values) < 0 ||
             bk_h5_describe(dset, p->unit, description) < 0)
@@ -388,6 +389,20 @@ int bk_h5_writer_set_point(bk_h5_writer *writer, const char *point, bk_error *er
     if (bk_h5_write_fixed_string_attr(writer->file, "point", point) < 0)
         return H5_FAIL(err, "%s: cannot write the root attribute point", writer->part);
     return BK_OK;
+}
+
+int bk_h5_writer_set_init_from(bk_h5_writer *writer, const char *source, double t_source, bk_error *err)
+{
+    if (!writer || !source)
+        return BK_FAIL(err, BK_ERR_INVALID, "bk_h5_writer_set_init_from: needs a writer and a source");
+    size_t len = strlen(source) + 96;
+    char *text = malloc(len);
+    if (!text)
+        return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", writer->part);
+    snprintf(text, len, "%s, its state at its end t = %.17g s", source, t_source);
+    herr_t rc = bk_h5_write_fixed_string_attr(writer->file, "init_from", text);
+    free(text);
+    return rc < 0 ? H5_FAIL(err, "%s: cannot write the root attribute init_from", writer->part) : BK_OK;
 }
 
 /* Extend dset by count rows and write them from buf. */
