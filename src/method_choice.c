@@ -125,7 +125,7 @@ const char *bk_choose_method(const bk_config *config, const bk_scene *scene)
     bk_boundary along = m->rows == 1 ? m->boundary_cols : m->boundary_rows;
     int dense_clusters = !line || along == BK_BOUNDARY_PERIODIC;
     size_t exact_max = dense_clusters ? AUTO_EXACT_MAX_RING : AUTO_EXACT_MAX_BLOCKS;
-    if (scene->affine && scene->n <= exact_max)
+    if (scene->affine && scene->n <= exact_max && (!scene->damped || bk_model_damping_proportional(m)))
         return "exact";
     /* A long chain that never sticks is cut into segments, which need CVODE's predictor. */
     if (local_stepping_applies(config, scene) && scene->n >= AUTO_LOCAL_MIN_BLOCKS)

@@ -127,8 +127,12 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     if (!problem->affine)
         return BK_FAIL(err, BK_ERR_CONFIG,
                        "method exact needs Coulomb friction (constant sliding force, no friction "
-                       "state) and no dashpots (no damping)" USE_INTEGRATOR);
+                       "state) and blocks with mass" USE_INTEGRATOR);
     size_t p = problem->n_pairs;
+    if (problem->dissipation_last && 2 * p >= n)
+        return BK_FAIL(err, BK_ERR_CONFIG,
+                       "method exact: the dashpots' dissipation is declared the last component, "
+                       "but there is no quadrature after the %zu pairs (n = %zu)", p, n);
     if (2 * p > n || (p > 0 && !problem->pair_mass))
         return BK_FAIL(err, BK_ERR_CONFIG,
                        "method exact needs the state as (position, velocity) pairs followed only "
@@ -147,6 +151,8 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     eb->t_stop = t_stop;
     eb->g_try_time = NAN;
     eb->n_couplings = 0;
+    eb->n_dampings = 0;
+    eb->dissipation = problem->dissipation_last != 0;
     eb->n_clusters = 0;
     memcpy(eb->y0, y0, n * sizeof *y0);
     memset(eb->P, 0, eb->m * p * sizeof *eb->P);
@@ -235,6 +241,28 @@ static double root_value(double t, void *user)
     return g;
 }
 
+/* Function rp->index is exactly zero at hi: it may have been so since well before, where a
+ * motion settles (a damped block's acceleration once it slides steadily rounds to exact
+ * zeros), and Brent has no sign change to work with.  Bisect for the earliest time it holds
+ * zero or its new sign, to the last few doubles. */
+static int earliest_zero(root_probe *rp, int old, double lo, double hi, double *t_root)
+{
+    while (hi - lo > 2.0 * DBL_EPSILON * fmax(fabs(lo), fabs(hi))) {
+        double mid = lo + 0.5 * (hi - lo);
+        if (mid <= lo || mid >= hi)
+            break;
+        double g = root_value(mid, rp);
+        if (rp->status != BK_OK)
+            return rp->status;
+        if (g * old <= 0.0)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    *t_root = hi;
+    return BK_OK;
+}
+
 /* Locate the crossing of function i in [lo, hi] (its old sign at or before lo, its new sign
  * or zero at hi, value g_hi): *t_root is the earliest time found where it holds its new
  * sign or zero, within a few doubles of the zero. */
@@ -244,11 +272,13 @@ static int locate(exact_backend *eb, size_t i, double lo, double hi, double g_hi
     root_probe rp = {.eb = eb, .index = i, .err = err, .status = BK_OK};
     gsl_function fn = {root_value, &rp};
     int old = eb->sign[i];
-    if (g_hi == 0.0 || hi <= lo) {
+    if (hi <= lo) {
         *t_root = hi;
         return BK_OK;
     }
     remember(&rp, hi, g_hi);
+    if (g_hi == 0.0)
+        return earliest_zero(&rp, old, lo, hi, t_root);
     /* lo's value differs from the last sign seen only when it is exactly zero there: the
      * crossing is at lo. */
     double g_lo = root_value(lo, &rp);
@@ -259,10 +289,12 @@ static int locate(exact_backend *eb, size_t i, double lo, double hi, double g_hi
         return BK_OK;
     }
     for (int attempt = 0; attempt < 64; ++attempt) {
-        if (g_hi == 0.0 || hi <= lo) {
+        if (hi <= lo) {
             *t_root = hi;
             return BK_OK;
         }
+        if (g_hi == 0.0)
+            return earliest_zero(&rp, old, lo, hi, t_root);
         int rc = gsl_root_fsolver_set(eb->shared->brent, &fn, lo, hi);
         if (rp.status != BK_OK)
             return rp.status;
@@ -435,6 +467,7 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
         *t_reached = eb->t_stop;
         return BK_STEP_STOP;
     }
+    eb->h = bk_exact_sampling_step(eb, lo);
     double hi = lo + eb->h;
     /* Never leave a sliver before the stop time. */
     if (!(hi < eb->t_stop - 1e-3 * eb->h))

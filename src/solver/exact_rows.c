@@ -12,7 +12,8 @@
  * leading term, 14 terms at most in practice, and the row is the closed form's to rounding.
  * The quadratures keep the modal form, O(m p) already (with every mode's sines, about half
  * of a series row's cost).  Small clusters keep the modal sum, cheaper below
- * SERIES_MIN_PAIRS. */
+ * SERIES_MIN_PAIRS, and so do damped ones, whose series (d_{n+2} = -K d_n - D d_{n+1}) this
+ * file does not sum: their rows cost the modal sum's O(size^2). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -32,7 +33,10 @@ int bk_exact_rows_prepare(exact_backend *eb, bk_error *err)
     size_t entries = 0;
     for (size_t cl = 0; cl < eb->n_clusters; ++cl) {
         size_t first = eb->first[cl], size = eb->first[cl + 1] - first;
-        eb->series[cl] = !eb->uniform[cl] && size >= SERIES_MIN_PAIRS;
+        int damped = 0;
+        for (size_t k = first; k < first + size; ++k)
+            damped |= eb->gamma[k] != 0.0;
+        eb->series[cl] = !eb->uniform[cl] && !damped && size >= SERIES_MIN_PAIRS;
         if (!eb->series[cl])
             continue;
         eb->n_series++;
