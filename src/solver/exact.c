@@ -1,32 +1,58 @@
 /* Exact piecewise-analytic stepper for affine problems (Coulomb friction, linear or frozen
- * tension-only springs, a constant-velocity driver).
+ * tension-only springs, a constant-velocity driver, dashpots in proportion to the masses and
+ * springs of each slipping stretch).
  *
  * What it computes.  Between two (re)starts the problem handed over is
  *
- *     xi'' = -K xi + a(t)          p pairs (xi, v = xi'), K = M^-1 (stiffness), constant
+ *     xi'' = -K xi - D v + a(t)    p pairs (xi, v = xi'), K = M^-1 (stiffness),
+ *                                  D = M^-1 C (dashpots), constant
  *     q'   = P xi + Q v + r(t)     quadratures (energy increments)
+ *     q_last' = v^T C v            the dashpots' dissipation, when the problem declares it
  *
- * with a and r affine in t.  start() reads K, P, Q and the affine forcing (measured from the
- * starting state, so that u = xi - xi0 starts at 0), splits the pairs into clusters (the
- * connected components of K's coupling), symmetrises each cluster's S = M^(1/2) K M^(-1/2)
- * and diagonalises it, S = U diag(w_k^2) U^T (GSL).  In the modal coordinates
- * eta = U^T M^(1/2) u each mode is an undamped oscillator with a ramp force, tau = t - t0:
+ * with a and r affine in t.  start() reads K, D, P, Q and the affine forcing (measured from
+ * the starting state, so that u = xi - xi0 starts at 0), splits the pairs into clusters (the
+ * connected components of K's and D's coupling), symmetrises each cluster's
+ * S = M^(1/2) K M^(-1/2) and diagonalises it, S = U diag(w_k^2) U^T (GSL).  The cluster's
+ * damping must be proportional, M^(1/2) D M^(-1/2) = alpha I + beta S (uniform masses and
+ * substrate dashpots; coupling dashpots in the ratio of the coupling springs on uniform
+ * driver springs): then U diagonalises it too, with gamma_k = alpha + beta w_k^2, and in the
+ * modal coordinates eta = U^T M^(1/2) u each mode is a damped oscillator with a ramp force,
+ * tau = t - t0:
  *
- *     eta_k'' = -w_k^2 eta_k + g_k + d_k tau,   eta_k(0) = 0,  eta_k'(0) = c_k
- *     eta_k   = c_k phi1 + g_k phi2 + d_k phi3,  eta_k' - c_k = -w_k^2 c_k phi2 + g_k phi1 + d_k phi2
+ *     eta_k'' + gamma_k eta_k' + w_k^2 eta_k = f_k + d_k tau,  eta_k(0) = 0,  eta_k'(0) = c_k,
+ *     f_k = g_k + gamma_k c_k (g_k: the mode's acceleration at the start)
+ *     eta_k = c_k phi1 + f_k phi2 + d_k phi3,  eta_k' - c_k = -w_k^2 c_k phi2 + g_k phi1 + d_k phi2
  *
- * where phi0 = cos(w tau), phi1 = sin(w tau)/w, and phi_{j+1} is the integral of phi_j from 0,
- * so phi2 = (1 - cos)/w^2 = 2 sin^2(w tau / 2)/w^2, phi3 = (tau - phi1)/w^2,
- * phi4 = (tau^2/2 - phi2)/w^2; for w tau < 2 phi3 and phi4 come from their power series,
- * and w = 0 (or w^2 within rounding of zero relative to the cluster's largest) gives
- * tau^j / j!.  The quadratures are the integrals of their affine rates along this solution,
- * again sums of phi2..phi4, in closed form.  Every evaluation of y(t) is exact up to rounding;
- * nothing is integrated, so there is no truncation error at all.
+ * where phi1 is the mode's impulse response (phi1(0) = 0, phi1'(0) = 1) and phi_{j+1} is the
+ * integral of phi_j from 0; eta' - c keeps its undamped form because phi0 = phi1' =
+ * 1 - gamma phi1 - w^2 phi2.  Undamped, phi0 = cos(w tau), phi1 = sin(w tau)/w,
+ * phi2 = (1 - cos)/w^2 = 2 sin^2(w tau / 2)/w^2, phi3 = (tau - phi1)/w^2,
+ * phi4 = (tau^2/2 - phi2)/w^2; for w tau < 2 phi3 and phi4 come from their power series, and
+ * w = 0 (or w^2 within rounding of zero relative to the cluster's largest) gives tau^j / j!.
+ * Damped (underdamped, critical, overdamped alike), exact_damped.c: the ODE's power series
+ * where the largest characteristic root times tau is below 2, the divided difference of the
+ * two real roots where clearly overdamped, else e^(-gamma tau / 2) times sin or the expm1
+ * form of sinh of the half-difference over the frequency, and the ODE's integrated
+ * identities upward.  The quadratures are the integrals of their affine rates along this
+ * solution, again sums of phi2..phi4, in closed form; the dissipation is each damped mode's
+ * energy balance, gamma int eta'^2 = -(eta'^2 - c^2)/2 - w^2 eta^2/2 + int (f + d tau) eta'.
+ * Every evaluation of y(t) is exact up to rounding; nothing is integrated, so there is no
+ * truncation error at all.  Damping that is not proportional couples the modes (their
+ * motion is no sum of real damped oscillators) and is refused with its reason; method =
+ * auto gives such scenes an integrator (bk_model_damping_proportional).
  *
  * Root functions are sampled along the exact solution at most every 1/16 of the shortest
  * modal period (and max_step); a sign change is located by GSL's Brent on the exact solution
  * to the last few representable doubles and reported with the state just after the crossing,
- * as CVODE does.  A function exactly zero at the start stays inactive until it moves away
+ * as CVODE does.  With dashpots a mode varies on the time scale of its largest
+ * characteristic root: |root| = w for an oscillating one (so 1/16 of its undamped period,
+ * shorter than 1/16 of its damped one), and for an overdamped one the slow root, and the
+ * fast root l- too until e^(l- tau) fell below e^-40 (bk_exact_sampling_step): a sampling
+ * step over which every exponential changes by at most e^(-2 pi / 16) = 0.68, as an
+ * oscillation turns by 22.5 degrees, so a sum of them cannot cross and cross back unseen any
+ * more than an undamped one can.  A function exactly zero over a stretch (a damped block's
+ * acceleration once it slides steadily, rounded to zeros) is located at its earliest zero
+ * by bisection.  A function exactly zero at the start stays inactive until it moves away
  * from zero (CVODE's convention).  A long island can have several transitions per sampling
  * step, and every probe evaluates all its root functions, so the number of probes per
  * transition is what must stay bounded: a step with several crossings is first halved toward
@@ -44,19 +70,20 @@
  * exactly those of the block-diagonal matrix, so nothing is approximated.  A chain stretch's
  * S is tridiagonal, and LAPACK's dstevr (relatively robust representations) diagonalises it
  * in O(p^2); only a ring slipping all round (cyclic S) goes through GSL's dense symmv, p^3.
- * K, P and Q come from the problem's exact Jacobian when it has one (O(p) entries, checked
+ * K, D, P and Q come from the problem's exact Jacobian when it has one (O(p) entries, checked
  * against the right-hand side by one combined probe) instead of one right-hand-side probe
  * per component, which is O(p^2).
  *
  * Why uniform clusters are special.  Blocks of equal mass, equal velocity and equal
- * acceleration whose stiffness rows sum alike (a uniform chain slipping together, its
- * couplings exactly balanced) move as one: their motion is the single oscillator of that
- * row sum.  The eigenvectors of such a cluster are exact only up to rounding, and summing
- * the modes back would give each block a slightly different motion, so a uniform chain
- * that physically slides as one would break into sub-events (seen: 3,393 transitions where
- * the integrators give 41 synchronous slips of 16 blocks).  So a uniform cluster is solved
- * as that one oscillator and every member gets the same numbers: symmetric inputs give
- * symmetric outputs, and the cost is O(p) however long the cluster. */
+ * acceleration whose stiffness rows sum alike and damping rows too (a uniform chain slipping
+ * together, its couplings exactly balanced) move as one: their motion is the single
+ * (damped) oscillator of those row sums.  The eigenvectors of such a cluster are exact only
+ * up to rounding, and summing the modes back would give each block a slightly different
+ * motion, so a uniform chain that physically slides as one would break into sub-events
+ * (seen: 3,393 transitions where the integrators give 41 synchronous slips of 16 blocks).
+ * So a uniform cluster is solved as that one oscillator and every member gets the same
+ * numbers: symmetric inputs give symmetric outputs, and the cost is O(p) however long the
+ * cluster. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
