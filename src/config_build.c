@@ -605,8 +605,7 @@ static void check_local_stepping(loader *ld, const bk_config *c)
 }
 
 /* The method fits the scene and takes the options given: method = exact solves only
- * affine scenes with proportional dashpots, arkode_table needs a method with tables.  Said
- * here, before any output. */
+ * affine scenes, arkode_table needs a method with tables.  Said here, before any output. */
 static void check_method_fits(loader *ld, const bk_config *c)
 {
     entry *method = bk_config_lookup(ld, "solver", "method");
@@ -632,13 +631,6 @@ static void check_method_fits(loader *ld, const bk_config *c)
                                "block; block %zu uses law %s (allowed: auto, or an integrator such as gsl_rk8pd "
                                "or cvode_bdf)",
                                i, c->model->blocks[i].law->name);
-    else if (bk_model_is_damped(c->model) && !bk_model_damping_proportional(c->model))
-        bk_config_report_entry(ld, method,
-                               "solves dashpots only in proportion to the masses and springs of each slipping "
-                               "stretch: (damping - coupling_damping / coupling_stiffness * driver_stiffness) / "
-                               "mass must be the same on every block, and coupling dashpots need linear driver "
-                               "springs; here it differs, which couples the damped modes (allowed: auto, which "
-                               "picks an integrator here, or one such as gsl_rk8pd or cvode_bdf)");
 }
 
 static int has_section(loader *ld, const char *section)

@@ -3,7 +3,10 @@
  * A Coulomb scene is linear with constant coefficients between transitions, so the exact
  * stepper is both exact and the fastest (up to AUTO_EXACT_MAX_BLOCKS blocks, see there), with
  * dashpots too as long as they are proportional to the masses and springs (each slipping
- * stretch's modes then decouple; other dashpots the exact stepper refuses).  Otherwise an
+ * stretch's modes then decouple).  Other dashpots it solves in each stretch's state space,
+ * no faster than gsl_rk8pd (1e3-block random chain, [block] damping = uniform(10, 30): 2.0 s
+ * against 1.9 s for 4e4 transitions) and refused where two modes merge, so those scenes get
+ * an integrator.  Otherwise an
  * explicit Runge-Kutta pair is cheapest unless the problem is stiff.  The stiffness measure
  * is the fastest decay rate of the linearised problem over its fastest oscillation
  * frequency, on a probe state (every block sliding at the driver speed, initial friction

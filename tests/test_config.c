@@ -661,11 +661,6 @@ static void test_rejections(void **state)
          "t.ini:5: [block] damping: out of range, got -2 (allowed: 0 <= damping < inf N s/m)"},
         {"n_blocks = 1\n", "n_blocks = 1\ncoupling_damping = -0.5\n",
          "t.ini:3: [model] coupling_damping: out of range, got -0.5 (allowed: 0 <= coupling_damping < inf N s/m)"},
-        /* exact takes proportional dashpots only; here block 0 alone has one */
-        {"n_blocks = 1\n", "n_blocks = 2\ncoupling_stiffness = 1e3\n[solver]\nmethod = exact\n[block.0]\ndamping = 1\n",
-         "t.ini:5: [solver] method: solves dashpots only in proportion to the masses and springs of each "
-         "slipping stretch: (damping - coupling_damping / coupling_stiffness * driver_stiffness) / mass must be "
-         "the same on every block"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         char text[4096];

@@ -148,7 +148,8 @@ static void test_damped_oscillator(void **state)
         double scale[4] = {0, 0, 0, 0};
         reference r = {&f, t0, y0[0], y0[1], y0[2], y0[3]};
         for (int e = -60; e <= 50; ++e) {
-            reference_advance(&r, (long double)t0 + 40.0L * powl(2.0L, (long double)e / 10.0L - 5.0L));
+            /* at the double t the stepper is asked for, not at t0 + tau rounded otherwise */
+            reference_advance(&r, (long double)(t0 + 40.0 * pow(2.0, (double)e / 10.0 - 5.0)));
             long double *row = ref[e + 60];
             row[0] = r.x, row[1] = r.v, row[2] = r.q0, row[3] = r.q1;
             for (size_t k = 0; k < 4; ++k)
@@ -158,16 +159,16 @@ static void test_damped_oscillator(void **state)
         bk_exact_damped_root(f.w * f.w, f.gamma, &root, &radius);
         double case_worst = 0.0;
         for (int e = -60; e <= 50; ++e) {
-            double tau = (double)(40.0L * powl(2.0L, (long double)e / 10.0L - 5.0L));
+            double tau = 40.0 * pow(2.0, (double)e / 10.0 - 5.0);
             double y[4];
             assert_int_equal(b->interpolate(mem, t0 + tau, y, &err), BK_OK);
             for (size_t k = 0; k < 4; ++k) {
                 double units = DBL_EPSILON * (1.0 + fmax(f.w, radius) * tau) * scale[k];
                 double e_units = fabs(y[k] - (double)ref[e + 60][k]) / units;
-                if (e_units > 64.0)
+                if (e_units > 16.0)
                     print_error("case %zu tau %.3g component %zu: %.17g vs %.17Lg (%.3g)\n", c, tau, k, y[k],
                                 ref[e + 60][k], e_units);
-                assert_true(e_units <= 64.0);
+                assert_true(e_units <= 16.0);
                 case_worst = fmax(case_worst, e_units);
             }
         }
@@ -220,62 +221,257 @@ static void test_overdamped_sampling(void **state)
     b->destroy(mem);
 }
 
-/* Two pairs whose dashpots are not in the ratio of their springs: refused at start, with
- * the reason and the way out; the same back-end then solves a proportional pair. */
-typedef struct pair2 {
-    double eta0, eta1, dissipation; /* the last rate: dissipation times v^T C v */
-} pair2;
+/* A small chain of n pairs with any symmetric stiffness and damping matrices (N/m, N s/m):
+ * x'' = M^-1 (-K x - C v + f0 + f1 t), quadratures q0' = sum (w_i x_i + z_i v_i) + 1 + 0.5 t and
+ * q1' = v^T C v (the dissipation, declared last).  Dashpots out of proportion with the
+ * masses and springs couple the modes: exact_coupled.c's state-space modes. */
+#define SMALL_MAX 4
 
-static int pair2_rhs(double t, const double *y, double *ydot, void *user)
+typedef struct small_chain {
+    size_t n;
+    double mass[SMALL_MAX], K[SMALL_MAX][SMALL_MAX], C[SMALL_MAX][SMALL_MAX];
+    double f0[SMALL_MAX], f1[SMALL_MAX], w[SMALL_MAX], z[SMALL_MAX];
+    double dissipation; /* the last rate is dissipation times v^T C v (1: the truth) */
+} small_chain;
+
+static int small_rhs(double t, const double *y, double *ydot, void *user)
 {
-    (void)t;
-    const pair2 *q = user;
-    double x0 = y[0], v0 = y[1], x1 = y[2], v1 = y[3];
-    ydot[0] = v0;
-    ydot[1] = -100.0 * x0 - 50.0 * (x0 - x1) - q->eta0 * v0 - 2.0 * (v0 - v1);
-    ydot[2] = v1;
-    ydot[3] = -100.0 * x1 - 50.0 * (x1 - x0) - q->eta1 * v1 - 2.0 * (v1 - v0);
-    ydot[4] = q->dissipation * (q->eta0 * v0 * v0 + q->eta1 * v1 * v1 + 2.0 * (v0 - v1) * (v0 - v1));
+    const small_chain *c = user;
+    size_t n = c->n;
+    double q0 = 1.0 + 0.5 * t, q1 = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        double f = c->f0[i] + c->f1[i] * t, cv = 0.0;
+        for (size_t j = 0; j < n; ++j) {
+            f -= c->K[i][j] * y[2 * j] + c->C[i][j] * y[2 * j + 1];
+            cv += c->C[i][j] * y[2 * j + 1];
+        }
+        ydot[2 * i] = y[2 * i + 1];
+        ydot[2 * i + 1] = f / c->mass[i];
+        q0 += c->w[i] * y[2 * i] + c->z[i] * y[2 * i + 1];
+        q1 += y[2 * i + 1] * cv;
+    }
+    ydot[2 * n] = q0;
+    ydot[2 * n + 1] = c->dissipation * q1;
     return 0;
 }
 
-static void test_refuses_coupled_damping(void **state)
+/* The same Taylor stepping as the oscillator's, with vectors; steps of a quarter over the
+ * largest Gershgorin rate. */
+typedef struct small_reference {
+    const small_chain *c;
+    long double t, x[SMALL_MAX], v[SMALL_MAX], q0, q1;
+} small_reference;
+
+static void small_advance(small_reference *r, long double t_to)
+{
+    const small_chain *c = r->c;
+    size_t n = c->n;
+    long double rate = 1.0L;
+    for (size_t i = 0; i < n; ++i) {
+        long double k = 0, d = 0;
+        for (size_t j = 0; j < n; ++j) {
+            k += fabsl((long double)c->K[i][j]);
+            d += fabsl((long double)c->C[i][j]);
+        }
+        rate = fmaxl(rate, sqrtl(k / c->mass[i]) + d / c->mass[i]);
+    }
+    long double h_max = 0.25L / rate;
+    while (r->t < t_to) {
+        long double h = fminl(h_max, t_to - r->t);
+        long double a[TAYLOR_TERMS + 2][SMALL_MAX], b[TAYLOR_TERMS + 1][SMALL_MAX];
+        for (size_t i = 0; i < n; ++i) {
+            a[0][i] = r->x[i];
+            a[1][i] = r->v[i];
+        }
+        for (int k = 0; k + 2 < TAYLOR_TERMS + 2; ++k)
+            for (size_t i = 0; i < n; ++i) {
+                long double f = k == 0 ? (long double)c->f0[i] + (long double)c->f1[i] * r->t
+                                       : k == 1 ? (long double)c->f1[i] : 0.0L;
+                for (size_t j = 0; j < n; ++j)
+                    f -= c->K[i][j] * a[k][j] + c->C[i][j] * (k + 1) * a[k + 1][j];
+                a[k + 2][i] = f / c->mass[i] / ((long double)(k + 1) * (k + 2));
+            }
+        for (int k = 0; k <= TAYLOR_TERMS; ++k)
+            for (size_t i = 0; i < n; ++i)
+                b[k][i] = (k + 1) * a[k + 1][i];
+        long double x[SMALL_MAX] = {0}, v[SMALL_MAX] = {0}, iq0 = 0, iq1 = 0, power = 1;
+        for (int k = 0; k <= TAYLOR_TERMS; ++k) {
+            long double affine = 0, square = 0;
+            for (size_t i = 0; i < n; ++i) {
+                x[i] += a[k][i] * power;
+                v[i] += b[k][i] * power;
+                affine += c->w[i] * a[k][i] + c->z[i] * b[k][i];
+                for (int l = 0; l <= k; ++l)
+                    for (size_t j = 0; j < n; ++j)
+                        square += b[l][i] * c->C[i][j] * b[k - l][j];
+            }
+            iq0 += affine * power * h / (k + 1);
+            iq1 += square * power * h / (k + 1);
+            power *= h;
+        }
+        long double t1 = r->t + h;
+        r->q0 += iq0 + h + 0.25L * (t1 * t1 - r->t * r->t);
+        r->q1 += iq1;
+        for (size_t i = 0; i < n; ++i) {
+            r->x[i] = x[i];
+            r->v[i] = v[i];
+        }
+        r->t = t1;
+    }
+}
+
+/* Three pairs, driver springs and a coupling each, dashpots unlike their springs:
+ * lightly damped, with an overdamped (real) mode, and heterogeneous masses with a ramp. */
+static small_chain small_case(int which)
+{
+    small_chain c = {.n = 3, .dissipation = 1.0};
+    const double kp[3] = {1e4, 1.3e4, 0.8e4}, kc[2] = {2e4, 1.5e4};
+    const double light[3] = {2.0, 30.0, 5.0}, heavy[3] = {900.0, 10.0, 40.0};
+    for (size_t i = 0; i < 3; ++i) {
+        c.mass[i] = which == 2 ? 1.0 + 0.6 * (double)i : 1.0;
+        c.K[i][i] = kp[i];
+        c.C[i][i] = which == 1 ? heavy[i] : light[i];
+        c.f0[i] = 5.0 * (double)i - 3.0;
+        c.f1[i] = which == 2 ? 40.0 - 25.0 * (double)i : 0.0;
+        c.w[i] = 0.3 * (double)i - 0.2;
+        c.z[i] = 0.7 - 0.4 * (double)i;
+    }
+    for (size_t i = 0; i < 2; ++i) {
+        c.K[i][i] += kc[i];
+        c.K[i + 1][i + 1] += kc[i];
+        c.K[i][i + 1] = c.K[i + 1][i] = -kc[i];
+        double etac = which == 1 ? 3.0 : 7.0 * (double)(i + 1);
+        c.C[i][i] += etac;
+        c.C[i + 1][i + 1] += etac;
+        c.C[i][i + 1] = c.C[i + 1][i] = -etac;
+    }
+    return c;
+}
+
+/* Dense output of coupled clusters against the reference, in units of eps (1 + |l| tau)
+ * of each component's scale; the dissipation is the energy lost. */
+static void test_coupled_modes(void **state)
 {
     (void)state;
     const bk_solver_backend *b = bk_solver_backend_find("exact");
     void *mem = NULL;
     bk_error err = {0};
     assert_int_equal(b->create(&mem, default_options(), &err), BK_OK);
-    static const double masses[2] = {1.0, 1.0};
-    double y0[5] = {0.01, 0.0, -0.02, 0.3, 0.0}, atol[5] = {1, 1, 1, 1, 1}, y[5], t;
-    pair2 unequal = {1.0, 5.0, 1.0};
-    bk_ode_problem p = {.user = &unequal, .rhs = pair2_rhs, .n_pairs = 2, .pair_mass = masses, .affine = 1,
+    double worst = 0.0;
+    for (int which = 0; which < 3; ++which) {
+        small_chain c = small_case(which);
+        size_t n = 2 * c.n + 2;
+        bk_ode_problem p = {.user = &c, .rhs = small_rhs, .n_pairs = c.n, .pair_mass = c.mass, .affine = 1,
+                            .dissipation_last = 1};
+        double y0[2 * SMALL_MAX + 2] = {1e-3, 0.05, -2e-3, -0.1, 5e-4, 0.02, 0.5, -0.3}, atol[2 * SMALL_MAX + 2];
+        for (size_t k = 0; k < n; ++k)
+            atol[k] = 1e-12;
+        const double t0 = 1.5;
+        if (b->start(mem, &p, t0, y0, atol, n, t0 + 2.0, &err) != BK_OK)
+            fail_msg("case %d: %s", which, err.message);
+        const exact_backend *eb = mem;
+        assert_int_equal(eb->n_clusters, 1);
+        assert_int_equal(eb->n_coupled, 1); /* not proportional: the state-space modes */
+        long double ref[81][2 * SMALL_MAX + 2];
+        double scale[2 * SMALL_MAX + 2] = {0};
+        small_reference r = {.c = &c, .t = t0, .q0 = y0[2 * c.n], .q1 = y0[2 * c.n + 1]};
+        for (size_t i = 0; i < c.n; ++i) {
+            r.x[i] = y0[2 * i];
+            r.v[i] = y0[2 * i + 1];
+        }
+        for (int e = -60; e <= 20; ++e) {
+            small_advance(&r, (long double)(t0 + 2.0 * pow(2.0, (double)e / 4.0 - 5.0)));
+            long double *row = ref[e + 60];
+            for (size_t i = 0; i < c.n; ++i) {
+                row[2 * i] = r.x[i];
+                row[2 * i + 1] = r.v[i];
+            }
+            row[2 * c.n] = r.q0;
+            row[2 * c.n + 1] = r.q1;
+            /* positions, velocities, each quadrature: one scale each */
+            for (size_t k = 0; k < n; ++k) {
+                size_t kind = k < 2 * c.n ? k % 2 : k;
+                scale[kind] = fmax(scale[kind], fabs((double)row[k]));
+            }
+        }
+        double rate = 0.0, case_worst = 0.0;
+        for (size_t i = 0; i < c.n; ++i) {
+            double k = 0.0, d = 0.0;
+            for (size_t j = 0; j < c.n; ++j) {
+                k += fabs(c.K[i][j]);
+                d += fabs(c.C[i][j]);
+            }
+            rate = fmax(rate, sqrt(k / c.mass[i]) + d / c.mass[i]);
+        }
+        for (int e = -60; e <= 20; ++e) {
+            double tau = 2.0 * pow(2.0, (double)e / 4.0 - 5.0), y[2 * SMALL_MAX + 2];
+            assert_int_equal(b->interpolate(mem, t0 + tau, y, &err), BK_OK);
+            for (size_t k = 0; k < n; ++k) {
+                size_t kind = k < 2 * c.n ? k % 2 : k;
+                double units = DBL_EPSILON * (1.0 + rate * tau) * scale[kind];
+                double e_units = fabs(y[k] - (double)ref[e + 60][k]) / units;
+                if (e_units > 32.0)
+                    print_error("case %d tau %.3g component %zu: %.17g vs %.17Lg (%.3g)\n", which, tau, k, y[k],
+                                ref[e + 60][k], e_units);
+                assert_true(e_units <= 32.0);
+                case_worst = fmax(case_worst, e_units);
+            }
+        }
+        print_message("coupled case %d: worst %.3g eps (1 + rate tau) of the component's scale\n", which,
+                      case_worst);
+        worst = fmax(worst, case_worst);
+    }
+    print_message("coupled modes: worst %.3g\n", worst);
+    b->destroy(mem);
+}
+
+/* What the exact stepper cannot solve is refused at start, with the reason and the way
+ * out: a last rate declared the dissipation that is not v^T C v, and coupled modes that
+ * merge (three free pairs tied by springs and by dashpots in another ratio: the free
+ * translation is undamped, a Jordan block no eigenvector basis holds). */
+static void test_refusals(void **state)
+{
+    (void)state;
+    const bk_solver_backend *b = bk_solver_backend_find("exact");
+    void *mem = NULL;
+    bk_error err = {0};
+    assert_int_equal(b->create(&mem, default_options(), &err), BK_OK);
+    double y0[2 * SMALL_MAX + 2] = {1e-3, 0.05, -2e-3, -0.1, 5e-4, 0.02, 0.5, -0.3}, atol[2 * SMALL_MAX + 2];
+    for (size_t k = 0; k < 2 * SMALL_MAX + 2; ++k)
+        atol[k] = 1.0;
+    small_chain twice = small_case(0);
+    twice.dissipation = 2.0;
+    bk_ode_problem p = {.user = &twice, .rhs = small_rhs, .n_pairs = 3, .pair_mass = twice.mass, .affine = 1,
                         .dissipation_last = 1};
-    assert_int_equal(b->start(mem, &p, 0.0, y0, atol, 5, 1.0, &err), BK_ERR_CONFIG);
-    print_message("unequal dashpots: %s\n", err.message);
-    assert_non_null(strstr(err.message, "not proportional to their masses and springs"));
-    assert_non_null(strstr(err.message, "use method = auto"));
-    /* a last rate declared the dissipation that is not v^T C v */
-    pair2 twice = {3.0, 3.0, 2.0};
-    p.user = &twice;
-    assert_int_equal(b->start(mem, &p, 0.0, y0, atol, 5, 1.0, &err), BK_ERR_CONFIG);
+    assert_int_equal(b->start(mem, &p, 0.0, y0, atol, 8, 1.0, &err), BK_ERR_CONFIG);
     print_message("not the dissipation: %s\n", err.message);
     assert_non_null(strstr(err.message, "is not the dashpots' dissipation"));
-    /* proportional, C = alpha M + beta K with alpha = -1 /s, beta = 0.04 s (modal damping
-     * 3 and 7 /s): solved, and the dissipation is the energy lost */
-    pair2 equal = {3.0, 3.0, 1.0};
-    p.user = &equal;
-    assert_int_equal(b->start(mem, &p, 0.0, y0, atol, 5, 1.0, &err), BK_OK);
-    int rc;
-    while ((rc = b->step(mem, &t, y, &err)) == BK_STEP_OK)
-        ;
-    assert_int_equal(rc, BK_STEP_STOP);
-    double k_energy = 0.5 * (y[1] * y[1] + y[3] * y[3]) - 0.5 * 0.09;
-    double p_energy = 0.5 * (100.0 * (y[0] * y[0] + y[2] * y[2]) + 50.0 * (y[0] - y[2]) * (y[0] - y[2])) -
-                      0.5 * (100.0 * (1e-4 + 4e-4) + 50.0 * 9e-4);
-    print_message("proportional pair: dissipated %.17g J, energy lost %.17g J\n", y[4], -(k_energy + p_energy));
-    assert_close(y[4], -(k_energy + p_energy), 1e-13, 1e-16);
-    assert_true(y[4] > 0.0);
+    assert_non_null(strstr(err.message, "use method = auto"));
+
+    small_chain free_chain = {.n = 3, .mass = {1.0, 1.0, 1.0}, .dissipation = 1.0};
+    const double kc[2] = {2e4, 1e4}, etac[2] = {5.0, 20.0};
+    for (size_t i = 0; i < 2; ++i) {
+        free_chain.K[i][i] += kc[i];
+        free_chain.K[i + 1][i + 1] += kc[i];
+        free_chain.K[i][i + 1] = free_chain.K[i + 1][i] = -kc[i];
+        free_chain.C[i][i] += etac[i];
+        free_chain.C[i + 1][i + 1] += etac[i];
+        free_chain.C[i][i + 1] = free_chain.C[i + 1][i] = -etac[i];
+    }
+    p.user = &free_chain;
+    p.pair_mass = free_chain.mass;
+    assert_int_equal(b->start(mem, &p, 0.0, y0, atol, 8, 1.0, &err), BK_ERR_CONFIG);
+    print_message("merging modes: %s\n", err.message);
+    assert_non_null(strstr(err.message, "nearly defective"));
+    assert_non_null(strstr(err.message, "use method = auto"));
+
+    /* the same back-end then solves a good problem */
+    small_chain good = small_case(1);
+    p.user = &good;
+    p.pair_mass = good.mass;
+    assert_int_equal(b->start(mem, &p, 0.0, y0, atol, 8, 1.0, &err), BK_OK);
+    double y[8], t;
+    assert_int_equal(b->step(mem, &t, y, &err), BK_STEP_OK);
     b->destroy(mem);
 }
 
@@ -500,14 +696,15 @@ static void test_uniform_damped_chain_slides_as_one(void **state)
 }
 
 /* Chains: uniform with dashpots to the substrate, uniform with coupling dashpots as well,
- * and heterogeneous (masses and driver springs varying along the chain, the dashpots
- * C = alpha M + beta K so that the damping stays proportional). */
-enum { CHAIN_SUBSTRATE, CHAIN_COUPLING, CHAIN_HETEROGENEOUS };
+ * heterogeneous (masses and driver springs varying along the chain, the dashpots
+ * C = alpha M + beta K so that the damping stays proportional), and heterogeneous with
+ * dashpots unlike the springs (coupled modes, exact_coupled.c). */
+enum { CHAIN_SUBSTRATE, CHAIN_COUPLING, CHAIN_HETEROGENEOUS, CHAIN_COUPLED };
 
 static bk_config *damped_chain(int kind, const char *method, double rtol, double damping_scale)
 {
     scene_spec spec = paper_case(0.5, BK_SPRING_LINEAR, 1e-10, method);
-    spec.n = kind == CHAIN_SUBSTRATE ? 10 : kind == CHAIN_COUPLING ? 20 : 30;
+    spec.n = kind == CHAIN_SUBSTRATE ? 10 : kind == CHAIN_HETEROGENEOUS ? 30 : 20;
     spec.coupling = 2e4;
     spec.boundary = kind == CHAIN_COUPLING ? BK_BOUNDARY_FIXED : BK_BOUNDARY_FREE;
     spec.rtol = rtol;
@@ -520,12 +717,14 @@ static bk_config *damped_chain(int kind, const char *method, double rtol, double
         bk_block *b = &m->blocks[i];
         b->x_init = 1e-5 * sin(2.385 * (double)i);
         b->friction_params[1] = 0.45 + 0.01 * (double)(i % 5);
-        if (kind == CHAIN_HETEROGENEOUS) {
+        if (kind >= CHAIN_HETEROGENEOUS) {
             b->mass = 1.0 + 0.5 * sin(1.3 * (double)i);
             b->driver_stiffness = 1e4 * (1.0 + 0.3 * cos(0.7 * (double)i));
             b->normal_force = b->mass * 9.81;
         }
         b->damping = damping_scale * (alpha * b->mass + beta * b->driver_stiffness);
+        if (kind == CHAIN_COUPLED)
+            b->damping = damping_scale * (4.0 + 30.0 * (1.0 + sin(3.1 * (double)i)));
     }
     bk_model_finalize(m);
     return c;
@@ -537,12 +736,12 @@ static void test_damped_chains_against_cvode(void **state)
 {
     (void)state;
     const char *names[] = {"10 blocks, substrate dashpots", "20 blocks, coupling dashpots, fixed ends",
-                           "30 blocks, heterogeneous"};
-    for (int kind = 0; kind < 3; ++kind) {
+                           "30 blocks, heterogeneous", "20 blocks, dashpots unlike the springs"};
+    for (int kind = 0; kind < 4; ++kind) {
         bk_config *ce = damped_chain(kind, "exact", 1e-10, 1.0);
         bk_config *cc = damped_chain(kind, "cvode_adams", 1e-12, 1.0);
         bk_config *cw = damped_chain(kind, "exact", 1e-10, 0.9); /* damping 10% off */
-        assert_true(bk_model_damping_proportional(ce->model));
+        assert_int_equal(bk_model_damping_proportional(ce->model), kind != CHAIN_COUPLED);
         recorder re = {0}, rc = {0}, rw = {0};
         bk_run_stats se, sc, sw;
         bk_error err = {0};
@@ -590,7 +789,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_damped_oscillator),
         cmocka_unit_test(test_overdamped_sampling),
-        cmocka_unit_test(test_refuses_coupled_damping),
+        cmocka_unit_test(test_coupled_modes),
+        cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_single_damped_block),
         cmocka_unit_test(test_uniform_damped_chain_slides_as_one),
         cmocka_unit_test(test_damped_chains_against_cvode),

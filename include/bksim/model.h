@@ -116,8 +116,9 @@ int bk_model_is_affine(const bk_model *model);
 /* Whether the dashpots of every stretch of blocks that can slip together are proportional
  * to its masses and springs, C = alpha M + beta K (beta = coupling_damping /
  * coupling_stiffness, and (damping_i - beta driver_stiffness_i) / mass_i the same alpha for
- * every block): then each stretch's modes are independent damped oscillators, which the
- * exact stepper solves.  1 without dashpots; blocks with mass only. */
+ * every block): then each stretch's modes are independent damped oscillators, the exact
+ * stepper's fast case, and method = auto picks it for such Coulomb scenes.  1 without
+ * dashpots; blocks with mass only. */
 int bk_model_damping_proportional(const bk_model *model);
 
 #endif

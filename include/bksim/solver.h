@@ -147,8 +147,7 @@ const bk_solver_backend *const *bk_solver_backends(void);
 
 extern const bk_solver_backend bk_solver_cvode_adams;
 extern const bk_solver_backend bk_solver_cvode_bdf;
-/* Exact piecewise-analytic (modal) stepper: affine problems only (Coulomb friction, dashpots
- * proportional to the masses and springs of each slipping stretch). */
+/* Exact piecewise-analytic (modal) stepper: affine problems only (Coulomb friction, dashpots). */
 extern const bk_solver_backend bk_solver_exact;
 /* ARKODE ARKStep (src/solver/arkode.c) */
 extern const bk_solver_backend bk_solver_arkode_bs23;

@@ -1,6 +1,5 @@
 /* Exact piecewise-analytic stepper for affine problems (Coulomb friction, linear or frozen
- * tension-only springs, a constant-velocity driver, dashpots in proportion to the masses and
- * springs of each slipping stretch).
+ * tension-only springs, a constant-velocity driver, dashpots).
  *
  * What it computes.  Between two (re)starts the problem handed over is
  *
@@ -12,12 +11,12 @@
  * with a and r affine in t.  start() reads K, D, P, Q and the affine forcing (measured from
  * the starting state, so that u = xi - xi0 starts at 0), splits the pairs into clusters (the
  * connected components of K's and D's coupling), symmetrises each cluster's
- * S = M^(1/2) K M^(-1/2) and diagonalises it, S = U diag(w_k^2) U^T (GSL).  The cluster's
- * damping must be proportional, M^(1/2) D M^(-1/2) = alpha I + beta S (uniform masses and
- * substrate dashpots; coupling dashpots in the ratio of the coupling springs on uniform
- * driver springs): then U diagonalises it too, with gamma_k = alpha + beta w_k^2, and in the
- * modal coordinates eta = U^T M^(1/2) u each mode is a damped oscillator with a ramp force,
- * tau = t - t0:
+ * S = M^(1/2) K M^(-1/2) and diagonalises it, S = U diag(w_k^2) U^T (GSL).  When the
+ * cluster's damping is proportional, M^(1/2) D M^(-1/2) = alpha I + beta S (uniform masses
+ * and substrate dashpots; coupling dashpots in the ratio of the coupling springs on uniform
+ * driver springs; no dashpots at all), U diagonalises it too, with gamma_k = alpha +
+ * beta w_k^2, and in the modal coordinates eta = U^T M^(1/2) u each mode is a damped
+ * oscillator with a ramp force, tau = t - t0:
  *
  *     eta_k'' + gamma_k eta_k' + w_k^2 eta_k = f_k + d_k tau,  eta_k(0) = 0,  eta_k'(0) = c_k,
  *     f_k = g_k + gamma_k c_k (g_k: the mode's acceleration at the start)
@@ -36,10 +35,16 @@
  * identities upward.  The quadratures are the integrals of their affine rates along this
  * solution, again sums of phi2..phi4, in closed form; the dissipation is each damped mode's
  * energy balance, gamma int eta'^2 = -(eta'^2 - c^2)/2 - w^2 eta^2/2 + int (f + d tau) eta'.
- * Every evaluation of y(t) is exact up to rounding; nothing is integrated, so there is no
- * truncation error at all.  Damping that is not proportional couples the modes (their
- * motion is no sum of real damped oscillators) and is refused with its reason; method =
- * auto gives such scenes an integrator (bk_model_damping_proportional).
+ * Damping that is not proportional couples the modes (their motion is no sum of real
+ * damped oscillators): such a cluster is solved in its 2p-dimensional state space instead,
+ * by the eigenvectors of [0 I; -S -Cs] (LAPACK dgeev; complex pairs in real form) and the
+ * exponential integrators' phi-functions of each eigenvalue (exact_coupled.c), with its
+ * dissipation from its energy balance; it is refused, with the reason, only where those
+ * eigenvectors are too ill-conditioned to be accurate (two modes merging: within ~1e-9 of
+ * critical damping, or an undamped free mode).  It is no faster than gsl_rk8pd there (a
+ * 2p x 2p eigenproblem per restart, 4 p^2 per probe), so method = auto gives such scenes an
+ * integrator (bk_model_damping_proportional).  Every evaluation of y(t) is exact up to
+ * rounding; nothing is integrated, so there is no truncation error at all.
  *
  * Root functions are sampled along the exact solution at most every 1/16 of the shortest
  * modal period (and max_step); a sign change is located by GSL's Brent on the exact solution
@@ -120,6 +125,8 @@ static void destroy(void *mem)
     free(eb->matrices);
     free(eb->row_col);
     free(eb->row_value);
+    free(eb->coupled_data);
+    free(eb->coupled_work);
     free(eb->direction);
     free(eb->sign);
     free(eb->found);

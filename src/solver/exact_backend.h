@@ -29,6 +29,12 @@
 /* An overdamped mode's fast exponential e^(l- tau) below e^-40 = 4e-18 of where it started
  * no longer limits the sampling step (see exact.c's header). */
 #define FAST_DECAYED 40.0
+/* A cluster whose damping couples its modes is solved by the eigenvectors of its 2p x 2p
+ * state matrix (exact_coupled.c); their condition number (1-norm) beyond this is refused:
+ * rounding grows with it, and it diverges where two damped modes merge, as 1 / (2 sqrt(|zeta
+ * - 1|)) near a critically damped mode (1e4: within 2.5e-9 of it), and an undamped free mode
+ * is a Jordan block (1.3e8 measured).  Healthy clusters measured 4 to 16. */
+#define COUPLED_MAX_CONDITION 1e4
 #define BRENT_MAX_ITER 200
 #define MAX_HALVINGS 16
 #define USE_INTEGRATOR "; use method = auto (it picks an integrator for such scenes), gsl_rk8pd or cvode_bdf"
@@ -66,7 +72,7 @@ typedef struct exact_backend {
     size_t n, p, m, n_roots;    /* state size, pairs, quadratures, root functions */
     double t0, t_stop, h;       /* start, stop, sampling step (of the step under way) */
     double h_slow;              /* the sampling step once every fast exponential decayed */
-    double *fast;               /* p: overdamped modes' fast decay rates, descending */
+    double *fast;               /* 2 p: overdamped modes' fast decay rates, descending */
     size_t n_fast, fast_live;   /* how many, and the first not yet decayed */
     double t_now;               /* time reached by the last step */
     double t_lo, t_hi;          /* the last step */
@@ -99,6 +105,13 @@ typedef struct exact_backend {
     size_t *members, *first, *offset; /* p (+1) each */
     size_t *cluster_of, *local, *parent; /* p (+1) each, during a start only (shared) */
     size_t *uniform;            /* per cluster: it moves as one (see the top of the file) */
+    size_t *coupled;            /* per cluster: 0, or 1 + the offset of its state-space modes
+                                   in coupled_data (its damping couples its modes) */
+    size_t n_coupled;
+    double *coupled_data;       /* exact_coupled.c's layout, per coupled cluster */
+    size_t coupled_cap;
+    double *coupled_work;       /* a start's work space for the largest coupled cluster */
+    size_t coupled_work_cap;
     size_t n_clusters;
     size_t n_couplings;         /* K's entries (in the shared work space) */
     size_t n_dampings;          /* D's entries (in the shared work space) */
@@ -166,8 +179,23 @@ void bk_exact_quadratures(const exact_backend *eb, double tau, double *y);
  * and radius, the largest root's modulus (1 / s); its basis phi[1..4] at tau. */
 void bk_exact_damped_root(double w2, double gamma, double *root, double *radius);
 void bk_exact_damped_basis(double w2, double gamma, double root, double radius, double tau, double phi[5]);
+/* exact_damped.c: phi_0 .. phi_3 of the exponential integrators at x <= 0 (e^x, and
+ * phi_k = (phi_{k-1} - 1/(k-1)!) / x), and at complex z with Re z <= 0; 1 / n!, n < 64. */
+void bk_exact_exp_phis(double x, double out[4]);
+void bk_exact_exp_phis_complex(double re, double im, double out_re[4], double out_im[4]);
+extern const double bk_exact_inverse_factorial[64];
 /* exact_modes.c: the sampling step for a step starting at t. */
 double bk_exact_sampling_step(exact_backend *eb, double t);
+/* exact_coupled.c: the state-space modes of every cluster marked coupled (after the other
+ * clusters' modes, while S and the symmetrised damping are in place; *rate_max grows to
+ * their oscillations' rates, their decays join the fast list); the amplitudes at tau, a
+ * coupled cluster's pairs, the coupled clusters' shares of quadrature j and of the
+ * dissipation. */
+int bk_exact_coupled_modes(exact_backend *eb, double *rate_max, bk_error *err);
+void bk_exact_coupled_amplitudes(exact_backend *eb, double tau);
+void bk_exact_coupled_state(const exact_backend *eb, size_t cl, double *y);
+double bk_exact_coupled_quadrature(const exact_backend *eb, size_t j);
+double bk_exact_coupled_dissipation(const exact_backend *eb, double tau);
 /* exact_rows.c: which clusters' rows come from the series, and their K (after
  * bk_exact_modes, while the couplings are in the shared work space); the state at t for an
  * output row, every cluster in O(its size). */

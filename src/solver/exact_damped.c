@@ -36,7 +36,7 @@
 /* Below this x the series (its terms shrink as x^n / n!; at x = 1 the upward recurrence
  * cost phi_4 250 eps near zeta = 1.1, against 13 eps with the switch at 2). */
 #define SERIES_RADIUS 2.0
-#define SERIES_TERMS 60 /* at most; inverse_factorial needs SERIES_TERMS + 4 */
+#define SERIES_TERMS 60 /* at most; bk_exact_inverse_factorial needs SERIES_TERMS + 4 */
 
 void bk_exact_damped_root(double w2, double gamma, double *root, double *radius)
 {
@@ -54,37 +54,10 @@ void bk_exact_damped_root(double w2, double gamma, double *root, double *radius)
     }
 }
 
-/* phi_k(x) of the exponential integrators, k = 0..3, x <= 0: e^x, and
- * phi_k = (phi_{k-1} - 1/(k-1)!) / x; the series sum_i x^i / (i + k)! for |x| < 1, where the
- * recurrence would cancel. */
-static void exp_phis(double x, double out[4])
-{
-    if (fabs(x) < 1.0) {
-        out[0] = exp(x);
-        for (int k = 1; k < 4; ++k) {
-            double term = 1.0, sum = 0.0;
-            for (int i = 1; i <= k; ++i)
-                term /= (double)i; /* 1 / k! */
-            for (int i = 0; i < 40 && term != 0.0; ++i) {
-                sum += term;
-                term *= x / (double)(i + k + 1);
-                if (fabs(term) <= 0x1p-60 * fabs(sum))
-                    break;
-            }
-            out[k] = sum;
-        }
-        return;
-    }
-    out[0] = exp(x);
-    out[1] = expm1(x) / x;
-    out[2] = (out[1] - 1.0) / x;
-    out[3] = (out[2] - 0.5) / x;
-}
-
 /* 1 / n!, n = 0 .. 63, correctly rounded: the series' weights, so that a term costs
  * multiplications only (a division per sum and term was a third of a long damped chain's
  * CPU). */
-static const double inverse_factorial[64] = {
+const double bk_exact_inverse_factorial[64] = {
     0x1.0000000000000p+0, 0x1.0000000000000p+0, 0x1.0000000000000p-1,
     0x1.5555555555555p-3, 0x1.5555555555555p-5, 0x1.1111111111111p-7,
     0x1.6c16c16c16c17p-10, 0x1.a01a01a01a01ap-13, 0x1.a01a01a01a01ap-16,
@@ -109,6 +82,75 @@ static const double inverse_factorial[64] = {
     0x1.00dcf6a320e1cp-290,
 };
 
+/* phi_k(x) of the exponential integrators, k = 0..3, x <= 0: e^x, and
+ * phi_k = (phi_{k-1} - 1/(k-1)!) / x; the series sum_i x^i / (i + k)! for |x| < 1, where the
+ * recurrence would cancel. */
+void bk_exact_exp_phis(double x, double out[4])
+{
+    out[0] = exp(x);
+    if (fabs(x) < 1.0) {
+        double sum[4] = {0.0, 0.0, 0.0, 0.0}, power = 1.0;
+        for (int i = 0; i < 30; ++i) {
+            const double *inv = &bk_exact_inverse_factorial[i];
+            for (int k = 1; k < 4; ++k)
+                sum[k] += power * inv[k];
+            if (fabs(power) * inv[1] <= 0x1p-60 * fabs(sum[1]))
+                break;
+            power *= x;
+        }
+        for (int k = 1; k < 4; ++k)
+            out[k] = sum[k];
+        return;
+    }
+    out[1] = expm1(x) / x;
+    out[2] = (out[1] - 1.0) / x;
+    out[3] = (out[2] - 0.5) / x;
+}
+
+/* The same at z = re + i im (re <= 0): a coupled cluster's complex modes.  The series below
+ * |z| = 1 (terms |z|^i / (i + k)!), else the recurrence from e^z; written out in real and
+ * imaginary parts. */
+void bk_exact_exp_phis_complex(double re, double im, double out_re[4], double out_im[4])
+{
+    double scale = exp(re);
+    out_re[0] = scale * cos(im);
+    out_im[0] = scale * sin(im);
+    if (re * re + im * im < 1.0) {
+        /* one pass for the three: term i of phi_k is z^i / (i + k)! */
+        double s_re[4] = {0.0, 0.0, 0.0, 0.0}, s_im[4] = {0.0, 0.0, 0.0, 0.0}, p_re = 1.0, p_im = 0.0;
+        for (int i = 0; i < 30; ++i) {
+            const double *inv = &bk_exact_inverse_factorial[i];
+            for (int k = 1; k < 4; ++k) {
+                s_re[k] += p_re * inv[k];
+                s_im[k] += p_im * inv[k];
+            }
+            /* |term| <= 2^-60 |sum| for phi_1 (the others' terms shrink faster), squared */
+            if ((p_re * p_re + p_im * p_im) * inv[1] * inv[1] <= 0x1p-120 * (s_re[1] * s_re[1] + s_im[1] * s_im[1]))
+                break;
+            double next_re = p_re * re - p_im * im;
+            p_im = p_re * im + p_im * re;
+            p_re = next_re;
+        }
+        for (int k = 1; k < 4; ++k) {
+            out_re[k] = s_re[k];
+            out_im[k] = s_im[k];
+        }
+        return;
+    }
+    /* (a + i b) / (re + i im) */
+    double norm = re * re + im * im;
+    double a = expm1(re) * cos(im) - 2.0 * sin(0.5 * im) * sin(0.5 * im), b = out_im[0]; /* e^z - 1 */
+    const double minus[4] = {0.0, 1.0, 0.5, 0.0};
+    for (int k = 1; k < 4; ++k) {
+        if (k > 1) {
+            a = out_re[k - 1] - minus[k - 1];
+            b = out_im[k - 1];
+        }
+        out_re[k] = (a * re + b * im) / norm;
+        out_im[k] = (b * re - a * im) / norm;
+    }
+}
+
 static void series(double w2, double gamma, double tau, double phi[5])
 {
     /* H_n = h_n tau^(n-1): H_1 = 1, H_2 = -gamma tau, H_{n+2} = -gamma tau H_{n+1} - w^2 tau^2 H_n;
@@ -117,7 +159,7 @@ static void series(double w2, double gamma, double tau, double phi[5])
     double s1 = 0.0, s2 = 0.0, s3 = 0.0, s4 = 0.0;
     double h_prev = 0.0, h = 1.0;
     for (int n = 1; n <= SERIES_TERMS; ++n) {
-        const double *inv = &inverse_factorial[n];
+        const double *inv = &bk_exact_inverse_factorial[n];
         s1 += h * inv[0];
         s2 += h * inv[1];
         s3 += h * inv[2];
@@ -147,8 +189,8 @@ void bk_exact_damped_basis(double w2, double gamma, double root, double radius, 
     if (root < 0.0 && -root >= 0.25 * sigma) {
         double mu = -root, slow = -w2 / (sigma + mu), fast = -(sigma + mu);
         double es[4], ef[4];
-        exp_phis(slow * tau, es);
-        exp_phis(fast * tau, ef);
+        bk_exact_exp_phis(slow * tau, es);
+        bk_exact_exp_phis(fast * tau, ef);
         /* phi_1 = e^(slow tau) (1 - e^(-2 mu tau)) / (2 mu), no overflow, no cancellation */
         phi[1] = -es[0] * expm1(-2.0 * mu * tau) / (2.0 * mu);
         double power = tau;

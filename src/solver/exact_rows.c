@@ -36,7 +36,7 @@ int bk_exact_rows_prepare(exact_backend *eb, bk_error *err)
         int damped = 0;
         for (size_t k = first; k < first + size; ++k)
             damped |= eb->gamma[k] != 0.0;
-        eb->series[cl] = !eb->uniform[cl] && !damped && size >= SERIES_MIN_PAIRS;
+        eb->series[cl] = !eb->uniform[cl] && !eb->coupled[cl] && !damped && size >= SERIES_MIN_PAIRS;
         if (!eb->series[cl])
             continue;
         eb->n_series++;

@@ -96,7 +96,7 @@ int bk_exact_reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_r
     eb->local = s->indices + p + 1;
     eb->parent = s->indices + 2 * (p + 1);
 
-    size_t need = 2 * n + 28 * p + 4 * m * p + 2 * m + 2;
+    size_t need = 2 * n + 29 * p + 4 * m * p + 2 * m + 2;
     double *arena = bk_fit_buffer(eb->arena, &eb->arena_cap, need, sizeof *arena);
     if (!arena)
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu components", n);
@@ -111,7 +111,7 @@ int bk_exact_reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_r
     eb->root = a, a += p;
     eb->radius = a, a += p;
     eb->mode_mass = a, a += p;
-    eb->fast = a, a += p;
+    eb->fast = a, a += 2 * p;
     eb->c = a, a += p;
     eb->g = a, a += p;
     eb->d = a, a += p;
@@ -138,7 +138,7 @@ int bk_exact_reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_r
     eb->qdot0 = a, a += m;
     eb->q_rate = a;
 
-    size_t *own_indices = bk_fit_buffer(eb->indices, &eb->indices_cap, 6 * (p + 1), sizeof *own_indices);
+    size_t *own_indices = bk_fit_buffer(eb->indices, &eb->indices_cap, 7 * (p + 1), sizeof *own_indices);
     if (!own_indices)
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu pairs", p);
     eb->indices = own_indices;
@@ -148,6 +148,7 @@ int bk_exact_reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_r
     eb->offset = ix, ix += p + 1;
     eb->uniform = ix, ix += p + 1;
     eb->series = ix, ix += p + 1;
+    eb->coupled = ix, ix += p + 1;
     eb->row_start = ix;
 
     if (n_roots > 0 && !bk_capacity_fits(n_roots, eb->roots_cap)) {
