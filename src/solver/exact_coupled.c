@@ -265,7 +265,7 @@ void bk_exact_coupled_state(const exact_backend *eb, size_t cl, double *y)
     layout L = layout_at(eb, cl);
     const size_t *members = &eb->members[eb->first[cl]];
     for (size_t r = 0; r < L.s; ++r) {
-        const double *tq = &L.Tq[r * L.N], *tr = &L.Tr[r * L.N];
+        const double *tq = L.Tq + r * L.N, *tr = L.Tr + r * L.N;
         double u = 0.0, dv = 0.0;
         for (size_t j = 0; j < L.N; ++j) {
             u += tq[j] * L.dxi[j];
@@ -284,7 +284,7 @@ double bk_exact_coupled_quadrature(const exact_backend *eb, size_t jq)
         if (!eb->coupled[k])
             continue;
         layout L = layout_at(eb, k);
-        const double *pq = &L.Pq[jq * L.N], *qr = &L.Qr[jq * L.N];
+        const double *pq = L.Pq + jq * L.N, *qr = L.Qr + jq * L.N;
         for (size_t j = 0; j < L.N; ++j)
             sum += (pq[j] + qr[j]) * L.ixi[j];
     }
@@ -302,7 +302,7 @@ double bk_exact_coupled_dissipation(const exact_backend *eb, double tau)
         const double *S = &eb->S[eb->offset[k]];
         double kinetic = 0.0, work = 0.0, potential = 0.0;
         for (size_t r = 0; r < L.s; ++r) {
-            const double *tq = &L.Tq[r * L.N], *tr = &L.Tr[r * L.N];
+            const double *tq = L.Tq + r * L.N, *tr = L.Tr + r * L.N;
             double u = 0.0, dv = 0.0, iu = 0.0;
             for (size_t j = 0; j < L.N; ++j) {
                 u += tq[j] * L.dxi[j];
