@@ -116,7 +116,6 @@ typedef struct exact_backend {
     size_t n_couplings;         /* K's entries (in the shared work space) */
     size_t n_dampings;          /* D's entries (in the shared work space) */
     int dissipation;            /* the last component is the dashpots' dissipation v^T C v */
-    int damped;                 /* some cluster has a damped mode */
     double *matrices;           /* S of each cluster (in place), then T = M^(-1/2) U of each */
     size_t matrices_cap;
     double *S, *T;

@@ -412,13 +412,14 @@ static int uniform_modes(exact_backend *eb, size_t k, bk_error *err)
     return BK_OK;
 }
 
-/* Cluster k's damping in the symmetrised coordinates, Cs = M^(1/2) D M^(-1/2) (assembled in
- * its T by split_clusters; the eigenvectors overwrite it after), must be alpha I + beta S (S symmetrised
- * already, largest entry s_max): then U diagonalises both and each mode is one damped
- * oscillator, gamma_k = alpha + beta w_k^2.  That is the case of uniform masses with uniform
- * dashpots to the substrate, and of coupling dashpots in the ratio of the coupling springs
- * (C = alpha M + beta K_springs) with uniform driver springs.  Other damping couples the
- * modes (their motion is not a sum of real damped oscillators) and is refused. */
+/* Whether cluster k's damping in the symmetrised coordinates, Cs = M^(1/2) D M^(-1/2)
+ * (assembled in its T by split_clusters; the eigenvectors overwrite it after), is
+ * alpha I + beta S (S symmetrised already, largest entry s_max): then U diagonalises both and
+ * each mode is one damped oscillator, gamma_k = alpha + beta w_k^2.  That is the case of
+ * uniform masses with uniform dashpots to the substrate, and of coupling dashpots in the
+ * ratio of the coupling springs (C = alpha M + beta K_springs) with uniform driver springs.
+ * Other damping couples the modes (their motion is not a sum of real damped oscillators):
+ * 0, and exact_coupled.c solves the cluster in its state space. */
 static int proportional_damping(const exact_backend *eb, size_t k, double s_max, double *alpha, double *beta)
 {
     size_t first = eb->first[k], size = eb->first[k + 1] - first;
@@ -575,14 +576,12 @@ int bk_exact_modes(exact_backend *eb, bk_error *err)
      * one, kept apart (descending), counts only until it decayed. */
     double rate_max = 0.0;
     eb->n_fast = eb->fast_live = 0;
-    eb->damped = 0;
     for (size_t k = 0; k < p; ++k) {
         if (eb->gamma[k] == 0.0) {
             eb->root[k] = eb->radius[k] = eb->omega[k];
             rate_max = fmax(rate_max, eb->omega[k]);
             continue;
         }
-        eb->damped = 1;
         bk_exact_damped_root(eb->omega2[k], eb->gamma[k], &eb->root[k], &eb->radius[k]);
         if (eb->root[k] < 0.0) {
             double sigma = 0.5 * eb->gamma[k], mu = -eb->root[k];
@@ -592,11 +591,8 @@ int bk_exact_modes(exact_backend *eb, bk_error *err)
             rate_max = fmax(rate_max, eb->radius[k]);
         }
     }
-    if (eb->n_coupled > 0) {
-        eb->damped = 1;
-        if ((rc = bk_exact_coupled_modes(eb, &rate_max, err)) != BK_OK)
-            return rc;
-    }
+    if (eb->n_coupled > 0 && (rc = bk_exact_coupled_modes(eb, &rate_max, err)) != BK_OK)
+        return rc;
     qsort(eb->fast, eb->n_fast, sizeof *eb->fast, descending);
     double h = rate_max > 0.0 ? 2.0 * PI / (SAMPLES_PER_PERIOD * rate_max) : INFINITY;
     double max_step = eb->max_step;
