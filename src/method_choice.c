@@ -38,7 +38,7 @@
  * transition (0.5 s at equal error, bench/ chain1000_damped: 9.8 ms against 28 ms at rtol
  * 1e-10); with coupling dashpots as well (coupling_damping = 100): 16 vs 35 us; nearly
  * uniform: 1.5 ms vs 0.35 ms at 1e3 blocks, 0.26 vs 0.15 ms at 300 (the damped modes cost
- * an exponential more per probe, and their rows take the modal sum).  So the same limits.  A
+ * an exponential more per probe).  So the same limits.  A
  * ring that slips all round is one cyclic cluster, dense and p^3 per restart (1e3 nearly
  * uniform blocks: 4.9 ms vs 0.37 ms per transition), so rings keep the earlier 100; so do
  * lattices of more than one row and column, whose clusters are never tridiagonal either. */

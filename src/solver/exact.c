@@ -125,6 +125,8 @@ static void destroy(void *mem)
     free(eb->matrices);
     free(eb->row_col);
     free(eb->row_value);
+    free(eb->damp_col);
+    free(eb->damp_value);
     free(eb->coupled_data);
     free(eb->coupled_work);
     free(eb->direction);

@@ -127,12 +127,16 @@ typedef struct exact_backend {
     /* Output rows of large clusters from the Taylor series about the last step end
      * (exact_rows.c): K of their pairs as compressed rows, the state at that step end, the
      * series' work vectors. */
-    size_t *series;             /* per cluster: its rows come from the series */
+    size_t *series;             /* per cluster: its rows come from the series (2: damped) */
     size_t n_series;            /* clusters whose rows do */
-    double *cluster_omega;      /* per cluster: its largest angular frequency */
+    double *cluster_omega;      /* per cluster: its largest angular frequency; when damped, a
+                                   bound on every rate of its motion (exact_rows.c) */
     size_t *row_start, *row_col;/* p + 1; one per coupling of those clusters */
     double *row_value;
     size_t row_col_cap, row_value_cap;
+    size_t *damp_start, *damp_col; /* D's rows of those clusters, the same way */
+    double *damp_value;
+    size_t damp_col_cap, damp_value_cap;
     double *yc, tc;             /* 2 p: the pairs at the last step end, and its time */
     double *even, *odd, *next_even, *next_odd; /* p each */
 

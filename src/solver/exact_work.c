@@ -138,7 +138,7 @@ int bk_exact_reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_r
     eb->qdot0 = a, a += m;
     eb->q_rate = a;
 
-    size_t *own_indices = bk_fit_buffer(eb->indices, &eb->indices_cap, 7 * (p + 1), sizeof *own_indices);
+    size_t *own_indices = bk_fit_buffer(eb->indices, &eb->indices_cap, 8 * (p + 1), sizeof *own_indices);
     if (!own_indices)
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu pairs", p);
     eb->indices = own_indices;
@@ -149,7 +149,8 @@ int bk_exact_reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_r
     eb->uniform = ix, ix += p + 1;
     eb->series = ix, ix += p + 1;
     eb->coupled = ix, ix += p + 1;
-    eb->row_start = ix;
+    eb->row_start = ix, ix += p + 1;
+    eb->damp_start = ix;
 
     if (n_roots > 0 && !bk_capacity_fits(n_roots, eb->roots_cap)) {
         free(eb->direction);
