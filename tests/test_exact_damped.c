@@ -21,6 +21,16 @@
 
 static double relative(double a, double b) { return fabs(a - b) / fmax(fabs(b), DBL_MIN); }
 
+/* The long double references below are worth their 11 extra bits only where long double
+ * arithmetic has them: valgrind does it in double, and then the references round like the
+ * stepper and the bounds on their difference widen by this (measured there: 131 eps where
+ * 2.5 natively, and the overdamped closed form must avoid cosh overflowing). */
+static double reference_slack(void)
+{
+    volatile long double one = 1.0L, tiny = 0x1p-60L;
+    return one + tiny != one ? 1.0 : 64.0;
+}
+
 static const bk_solver_options *default_options(void)
 {
     static bk_solver_options o;
@@ -166,10 +176,10 @@ static void test_damped_oscillator(void **state)
             for (size_t k = 0; k < 4; ++k) {
                 double units = DBL_EPSILON * (1.0 + fmax(f.w, radius) * tau) * scale[k];
                 double e_units = fabs(y[k] - (double)ref[e + 60][k]) / units;
-                if (e_units > 16.0)
+                if (e_units > 16.0 * reference_slack())
                     print_error("case %zu tau %.3g component %zu: %.17g vs %.17Lg (%.3g)\n", c, tau, k, y[k],
                                 ref[e + 60][k], e_units);
-                assert_true(e_units <= 16.0);
+                assert_true(e_units <= 16.0 * reference_slack());
                 case_worst = fmax(case_worst, e_units);
             }
         }
@@ -411,10 +421,10 @@ static void test_coupled_modes(void **state)
                 size_t kind = k < 2 * c.n ? k % 2 : k;
                 double units = DBL_EPSILON * (1.0 + rate * tau) * scale[kind];
                 double e_units = fabs(y[k] - (double)ref[e + 60][k]) / units;
-                if (e_units > 32.0)
+                if (e_units > 32.0 * reference_slack())
                     print_error("case %d tau %.3g component %zu: %.17g vs %.17Lg (%.3g)\n", which, tau, k, y[k],
                                 ref[e + 60][k], e_units);
-                assert_true(e_units <= 32.0);
+                assert_true(e_units <= 32.0 * reference_slack());
                 case_worst = fmax(case_worst, e_units);
             }
         }
@@ -619,45 +629,49 @@ typedef struct block_event {
     int to;
 } block_event;
 
-static long double slip_rate(const damped_block *p, long double y0, long double dy0, long double tau)
+/* e^(-sigma tau) C(tau) and e^(-sigma tau) S(tau) of the block's slip (above), and sigma,
+ * w^2; overdamped with mu tau > 1 from the two exponentials, so that nothing overflows
+ * where long double has only double's range (valgrind). */
+static void decayed_basis(const damped_block *p, long double tau, long double *C, long double *S,
+                          long double *sigma_out, long double *w2_out)
 {
     long double m = p->mass, k = p->stiffness, eta = p->eta;
     long double sigma = eta / (2 * m), w = sqrtl(k / m), nu2 = (w - sigma) * (w + sigma);
-    long double C, S;
+    long double decay = expl(-sigma * tau);
     if (nu2 > 0) {
         long double nu = sqrtl(nu2);
-        C = cosl(nu * tau);
-        S = sinl(nu * tau) / nu;
+        *C = decay * cosl(nu * tau);
+        *S = decay * sinl(nu * tau) / nu;
     } else if (nu2 < 0) {
         long double mu = sqrtl(-nu2);
-        C = coshl(mu * tau);
-        S = sinhl(mu * tau) / mu;
+        if (mu * tau < 1) {
+            *C = decay * coshl(mu * tau);
+            *S = decay * sinhl(mu * tau) / mu;
+        } else {
+            long double slow = expl((mu - sigma) * tau), fast = expl(-(mu + sigma) * tau);
+            *C = (slow + fast) / 2;
+            *S = (slow - fast) / (2 * mu);
+        }
     } else {
-        C = 1;
-        S = tau;
+        *C = decay;
+        *S = decay * tau;
     }
-    long double dy = expl(-sigma * tau) * (dy0 * C - (sigma * dy0 + w * w * y0) * S);
-    return (long double)p->velocity + dy;
+    *sigma_out = sigma;
+    *w2_out = w * w;
+}
+
+static long double slip_rate(const damped_block *p, long double y0, long double dy0, long double tau)
+{
+    long double C, S, sigma, w2;
+    decayed_basis(p, tau, &C, &S, &sigma, &w2);
+    return (long double)p->velocity + dy0 * C - (sigma * dy0 + w2 * y0) * S;
 }
 
 static long double slip_position(const damped_block *p, long double y0, long double dy0, long double tau)
 {
-    long double m = p->mass, k = p->stiffness, eta = p->eta;
-    long double sigma = eta / (2 * m), w = sqrtl(k / m), nu2 = (w - sigma) * (w + sigma);
-    long double C, S;
-    if (nu2 > 0) {
-        long double nu = sqrtl(nu2);
-        C = cosl(nu * tau);
-        S = sinl(nu * tau) / nu;
-    } else if (nu2 < 0) {
-        long double mu = sqrtl(-nu2);
-        C = coshl(mu * tau);
-        S = sinhl(mu * tau) / mu;
-    } else {
-        C = 1;
-        S = tau;
-    }
-    return expl(-sigma * tau) * (y0 * C + (dy0 + sigma * y0) * S);
+    long double C, S, sigma, w2;
+    decayed_basis(p, tau, &C, &S, &sigma, &w2);
+    return y0 * C + (dy0 + sigma * y0) * S;
 }
 
 /* The block's transitions on [0, t_end]; the count, or -1 where the motion leaves the cases
