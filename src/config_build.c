@@ -632,11 +632,6 @@ static void check_method_fits(loader *ld, const bk_config *c)
                                "block; block %zu uses law %s (allowed: auto, or an integrator such as gsl_rk8pd "
                                "or cvode_bdf)",
                                i, c->model->blocks[i].law->name);
-    else if (bk_model_is_damped(c->model))
-        bk_config_report_entry(ld, method,
-                               "solves motion whose forces do not depend on velocity; [block] damping or [model] "
-                               "coupling_damping makes them (allowed: auto, which picks an integrator here, or one "
-                               "such as gsl_rk8pd or cvode_bdf)");
 }
 
 static int has_section(loader *ld, const char *section)

@@ -109,7 +109,7 @@ static const key_def keys[] = {
         "driver position at t = 0 (0: at the relaxed blocks)"),
 
     {"solver", {"method", "", 0, 0, 0, 0,
-                "integrator back-end; auto: exact for Coulomb scenes (open chains up to 1000 blocks, rings up to 100), cvode_bdf in segments for chains of 72 or more blocks that never stick (local_stepping), else gsl_rk8pd, or cvode_bdf when stiff (README \"Solver back-ends\")"},
+                "integrator back-end; auto: exact for Coulomb scenes, dashpots included when proportional to the masses and springs (open chains up to 1000 blocks, rings up to 100), cvode_bdf in segments for chains of 72 or more blocks that never stick (local_stepping), else gsl_rk8pd, or cvode_bdf when stiff (README \"Solver back-ends\")"},
      BK_KEY_CHOICE, NULL, bk_config_method_name, "auto"},
     {"solver", {"linear_solver", "", 0, 0, 0, 0, "linear solver of implicit methods: auto (band for long chains), dense, band"},
      BK_KEY_CHOICE, bk_config_linear_solver_names, NULL, "auto"},

@@ -1,7 +1,13 @@
 /* method = auto: the cheapest adequate back-end for the scene, from bench/ measurements.
  *
  * A Coulomb scene is linear with constant coefficients between transitions, so the exact
- * stepper is both exact and the fastest (up to AUTO_EXACT_MAX_BLOCKS blocks, see there).  Otherwise an
+ * stepper is both exact and the fastest (up to AUTO_EXACT_MAX_BLOCKS blocks, see there), with
+ * dashpots too as long as they are proportional to the masses and springs (each slipping
+ * stretch's modes then decouple) and do not overdamp the fastest modes heavily (see
+ * AUTO_EXACT_MAX_OVERDAMPING).  Other dashpots it solves in each stretch's state space,
+ * no faster than gsl_rk8pd (1e3-block random chain, [block] damping = uniform(10, 30): 2.0 s
+ * against 1.9 s for 4e4 transitions) and refused where two modes merge, so those scenes get
+ * an integrator.  Otherwise an
  * explicit Runge-Kutta pair is cheapest unless the problem is stiff.  The stiffness measure
  * is the fastest decay rate of the linearised problem over its fastest oscillation
  * frequency, on a probe state (every block sliding at the driver speed, initial friction
@@ -27,12 +33,27 @@
  *   transition restarting it: O(p^2) for exact's eigen-solver, O(p) for the integrator):
  *   1e3 blocks 1.1 ms vs 0.35 ms, 3e3 blocks 3.8 vs 0.9 ms.
  * So exact up to 1e3 blocks (2x faster on the usual heterogeneous chain, 3x slower at
- * worst); beyond, the worst case grows with N and the integrator is the safe default.  A
+ * worst); beyond, the worst case grows with N and the integrator is the safe default.
+ * Dashpots ([block] damping = 20 N s/m, damping ratio 0.1 on the driver spring) change
+ * neither side of that: random chain, 1e3 blocks, 2 s: exact 24 vs gsl_rk8pd 45 us per
+ * transition (0.5 s at equal error, bench/ chain1000_damped: 9.8 ms against 28 ms at rtol
+ * 1e-10); with coupling dashpots as well (coupling_damping = 100): 16 vs 35 us; nearly
+ * uniform: 1.5 ms vs 0.35 ms at 1e3 blocks, 0.26 vs 0.15 ms at 300 (the damped modes cost
+ * an exponential more per probe).  So the same limits.  A
  * ring that slips all round is one cyclic cluster, dense and p^3 per restart (1e3 nearly
  * uniform blocks: 4.9 ms vs 0.37 ms per transition), so rings keep the earlier 100; so do
  * lattices of more than one row and column, whose clusters are never tridiagonal either. */
 #define AUTO_EXACT_MAX_BLOCKS 1000
 #define AUTO_EXACT_MAX_RING 100
+/* Heavily overdamped fast modes cost the exact stepper samples (each restart samples at 16
+ * per 2 pi of their decay rate until they have decayed, 40 decay times) that an explicit
+ * integrator, bounded by its stability on the same rate, spends as steps; the random
+ * 1000-block chain, 0.5 s, CPU exact vs gsl_rk8pd at rtol 1e-10, against the estimate below:
+ *   [block] damping 200: 0.33, 0.019 vs 0.043 s;  600: 1.0, 0.033 vs 0.038;  2000: 3.3, 0.044
+ *   vs 0.038;  coupling_damping 100: 0.7, 0.017 vs 0.041;  300: 2.0, 0.042 vs 0.055;  1000:
+ *   6.7, 0.076 vs 0.048;  2000: 13, 0.092 vs 0.068.
+ * So exact up to an estimated damping ratio of 2.5. */
+#define AUTO_EXACT_MAX_OVERDAMPING 2.5
 #define STIFF_RATIO 50.0
 /* The fewest blocks for which method = auto cuts a chain that never sticks into segments:
  * CPU per rupture on the Dieterich-Ruina ring (bench/rs_chains.tsv, rtol 1e-8), whole vs in
@@ -102,6 +123,22 @@ double bk_stiffness_ratio(const bk_model *model)
     return ratio;
 }
 
+/* The damping ratio of the fastest modes, from Gershgorin bounds: the largest row sum of
+ * M^-1 C over twice the largest angular frequency (0 without dashpots). */
+static double overdamping(const bk_model *model)
+{
+    double gamma = 0.0;
+    for (size_t i = 0; i < model->n_blocks; ++i) {
+        const bk_block *b = &model->blocks[i];
+        if (!(b->mass > 0.0))
+            continue;
+        double row = b->damping + 2.0 * bk_model_coupling_count(model, i) * model->coupling_damping;
+        gamma = fmax(gamma, row / b->mass);
+    }
+    double omega = bk_model_max_angular_frequency(model);
+    return omega > 0.0 ? gamma / (2.0 * omega) : (gamma > 0.0 ? INFINITY : 0.0);
+}
+
 /* The scene stays one island whatever happens (no block sticks, no spring goes slack), and
  * local stepping is not switched off. */
 static int local_stepping_applies(const bk_config *config, const bk_scene *scene)
@@ -125,7 +162,8 @@ const char *bk_choose_method(const bk_config *config, const bk_scene *scene)
     bk_boundary along = m->rows == 1 ? m->boundary_cols : m->boundary_rows;
     int dense_clusters = !line || along == BK_BOUNDARY_PERIODIC;
     size_t exact_max = dense_clusters ? AUTO_EXACT_MAX_RING : AUTO_EXACT_MAX_BLOCKS;
-    if (scene->affine && scene->n <= exact_max)
+    if (scene->affine && scene->n <= exact_max &&
+        (!scene->damped || (bk_model_damping_proportional(m) && overdamping(m) <= AUTO_EXACT_MAX_OVERDAMPING)))
         return "exact";
     /* A long chain that never sticks is cut into segments, which need CVODE's predictor. */
     if (local_stepping_applies(config, scene) && scene->n >= AUTO_LOCAL_MIN_BLOCKS)

@@ -1,6 +1,7 @@
 /* Forces and energies of a Burridge-Knopoff chain (equations in include/bksim/model.h). */
 #include "bksim/model.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 
@@ -245,4 +246,31 @@ size_t bk_model_first_non_affine_block(const bk_model *model)
 int bk_model_is_affine(const bk_model *model)
 {
     return bk_model_first_non_affine_block(model) == model->n_blocks;
+}
+
+int bk_model_damping_proportional(const bk_model *model)
+{
+    size_t n = model->n_blocks;
+    double kc = model->coupling_stiffness, etac = model->coupling_damping;
+    if (n <= 1 || (kc == 0.0 && etac == 0.0))
+        return 1; /* every slipping stretch is one block */
+    if (etac > 0.0 && !(kc > 0.0))
+        return 0; /* blocks tied by dashpots alone */
+    double beta = etac > 0.0 ? etac / kc : 0.0;
+    /* a slack driver spring drops out of K, not its share beta k_p of C */
+    if (beta > 0.0 && model->spring == BK_SPRING_TENSION_ONLY)
+        for (size_t i = 0; i < n; ++i)
+            if (model->blocks[i].driver_stiffness != 0.0)
+                return 0;
+    const bk_block *b0 = &model->blocks[0];
+    double alpha = (b0->damping - beta * b0->driver_stiffness) / b0->mass;
+    double scale0 = (b0->damping + beta * b0->driver_stiffness) / b0->mass;
+    for (size_t i = 1; i < n; ++i) {
+        const bk_block *b = &model->blocks[i];
+        double a = (b->damping - beta * b->driver_stiffness) / b->mass;
+        double scale = fmax(scale0, (b->damping + beta * b->driver_stiffness) / b->mass);
+        if (!(fabs(a - alpha) <= 64.0 * DBL_EPSILON * scale))
+            return 0;
+    }
+    return 1;
 }

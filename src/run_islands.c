@@ -272,6 +272,8 @@ int bk_run_start_island(run_ctx *ctx, size_t id, double t)
         .n_pairs = ctx->model->n_friction_state == 0 && !ctx->scene.full_layout ? island->n_active : 0,
         .pair_mass = island->active_mass,
         .affine = island->affine,
+        /* the last energy increment, when damped, is the dashpots' (island.c) */
+        .dissipation_last = ctx->scene.damped,
         .differential_id = ctx->scene.full_layout ? island->differential_id : NULL,
     };
     if (island->n_y > isl->solver_peak)

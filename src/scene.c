@@ -40,10 +40,11 @@ int bk_scene_init(bk_scene *scene, const bk_model *model, int detect_extrema)
         bk_scene_free(scene);
         return -1;
     }
-    /* Stateless constant-force laws, no dashpots and a constant-velocity driver make every
-     * frozen-mode segment affine, with forces independent of velocity (the exact stepper). */
+    /* Stateless constant-force laws and a constant-velocity driver make every frozen-mode
+     * segment affine, dashpots included (the exact stepper; the dashpots' dissipation, its
+     * one quadratic rate, is declared to it as such). */
     scene->damped = bk_model_is_damped(model);
-    scene->affine = bk_model_is_affine(model) && !scene->damped;
+    scene->affine = bk_model_is_affine(model);
     scene->n_energy = scene->damped ? 3 : 2;
     for (size_t i = 0; i < n; ++i) {
         const bk_block *b = &model->blocks[i];

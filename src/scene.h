@@ -64,8 +64,8 @@ typedef struct bk_scene {
                                 minimum: it never starts at or hovers around zero (a slip
                                 that starts with zero acceleration, steady sliding). */
     int full_layout;         /* islands keep their stuck blocks in y (see above) */
-    int affine;              /* every law Coulomb-like, no dashpots: islands' ODEs are affine in y
-                                and t, accelerations independent of velocities */
+    int affine;              /* every law Coulomb-like: islands' ODEs are affine in y and t (but
+                                for the dashpots' dissipation, quadratic in v) */
     int damped;              /* some dashpot (bk_model_is_damped) */
     double balance_time;     /* s: blocks without mass return to their force balance at this
                                 time constant when the integration drifts off it (island.c) */

@@ -223,14 +223,15 @@ static void test_restart_equivalence(void **state)
 {
     (void)state;
     /* gsl_rk8pd resets its stepper when a size repeats instead of making a new one: the
-     * resumed run's fresh instances must compute what the reused ones do.  The damped run
-     * carries its dashpot dissipation through the checkpoints; the slide-hold-slide chain
+     * resumed run's fresh instances must compute what the reused ones do.  The damped runs
+     * (an integrator's and the exact stepper's) carry their dashpot dissipation through the
+     * checkpoints; the slide-hold-slide chain
      * resumes between and at its driver's breakpoints. */
-    const char *methods[] = {"cvode_adams", "exact", "gsl_rk8pd", "gsl_rk8pd", "gsl_rk8pd"};
-    const char *extra[] = {"", "", "", "--set block.damping=20", ""};
+    const char *methods[] = {"cvode_adams", "exact", "gsl_rk8pd", "gsl_rk8pd", "gsl_rk8pd", "exact"};
+    const char *extra[] = {"", "", "", "--set block.damping=20", "", "--set block.damping=20"};
     const char *configs[] = {"paper/case_b_coulomb", "paper/case_b_coulomb", "paper/case_b_coulomb",
-                             "paper/case_b_coulomb", "chains/slide_hold_slide_10"};
-    for (size_t m = 0; m < 5; ++m) {
+                             "paper/case_b_coulomb", "chains/slide_hold_slide_10", "paper/case_b_coulomb"};
+    for (size_t m = 0; m < 6; ++m) {
         char reference[512], stopped[512], part[600], cmd[2048];
         snprintf(reference, sizeof reference, "%s/reference_%s_%zu.h5", tmpdir, methods[m], m);
         snprintf(stopped, sizeof stopped, "%s/stopped_%s_%zu.h5", tmpdir, methods[m], m);

@@ -68,6 +68,16 @@ static void test_choices(void **state)
         {"configs/chains/bk1000_coulomb.ini", "model.boundary=periodic", "exact", "model.n_blocks=100"},
         {"configs/paper/case_c_coulomb_tension_only.ini", NULL, "exact", NULL},
         {"configs/chains/bk10_coulomb.ini", NULL, "exact", NULL},
+        /* Dashpots: exact when proportional to the masses and springs (uniform here, or
+         * coupling dashpots in the springs' ratio), an integrator when they differ ... */
+        {"configs/chains/bk10_coulomb.ini", "block.damping=20", "exact", "model.coupling_damping=40"},
+        {"configs/chains/bk10_coulomb.ini", "block.damping=20", "gsl_rk8pd", "block.3.damping=50"},
+        {"configs/chains/bk10_coulomb.ini", "block.3.mass=2", "gsl_rk8pd", "block.damping=20"},
+        {"configs/chains/bk10_coulomb.ini", "block.3.driver_stiffness=2e4", "gsl_rk8pd", "model.coupling_damping=40"},
+        /* ... and an integrator when they overdamp the fastest modes heavily */
+        {"configs/chains/bk10_coulomb.ini", "block.damping=600", "exact", NULL},
+        {"configs/chains/bk10_coulomb.ini", "block.damping=2000", "gsl_rk8pd", NULL},
+        {"configs/chains/bk10_coulomb.ini", "model.coupling_damping=1000", "gsl_rk8pd", NULL},
         {"configs/paper/case_a_rs.ini", NULL, "gsl_rk8pd", NULL},
         {"configs/paper/case_b_rs.ini", NULL, "gsl_rk8pd", NULL},
         {"configs/paper/case_c_rs.ini", NULL, "gsl_rk8pd", NULL},

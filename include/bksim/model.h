@@ -116,9 +116,16 @@ int bk_model_coupling_count(const bk_model *model, size_t i);
 double bk_model_block_stiffness(const bk_model *model, size_t i);
 /* The first block whose law has a state or a velocity-dependent sliding force, or n_blocks
  * when there is none: every law Coulomb-like, so between mode changes the chain is linear
- * with constant coefficients (what method = exact needs). */
+ * with constant coefficients, dashpots included (what method = exact needs). */
 size_t bk_model_first_non_affine_block(const bk_model *model);
 /* bk_model_first_non_affine_block(model) == n_blocks */
 int bk_model_is_affine(const bk_model *model);
+/* Whether the dashpots of every stretch of blocks that can slip together are proportional
+ * to its masses and springs, C = alpha M + beta K (beta = coupling_damping /
+ * coupling_stiffness, and (damping_i - beta driver_stiffness_i) / mass_i the same alpha for
+ * every block): then each stretch's modes are independent damped oscillators, the exact
+ * stepper's fast case, and method = auto picks it for such Coulomb scenes.  1 without
+ * dashpots; blocks with mass only. */
+int bk_model_damping_proportional(const bk_model *model);
 
 #endif

@@ -42,12 +42,15 @@ typedef struct bk_ode_problem {
     size_t half_bandwidth;     /* Jacobian bandwidth each side, for band solvers */
     /* Structure, for back-ends that exploit it (the exact stepper).  y starts with n_pairs
      * (position, velocity) pairs; the rest are quadratures (their derivatives do not depend
-     * on themselves).  When affine is set, y' = A y + b0 + b1 t exactly, accelerations do
-     * not depend on velocities, and pair_mass[k] is the mass of pair k (kg), so that
-     * M^(1/2) (d accel / d position) M^(-1/2) is symmetric. */
+     * on themselves).  When affine is set, y' = A y + b0 + b1 t exactly, and pair_mass[k] is
+     * the mass of pair k (kg), so that M^(1/2) (d accel / d position) M^(-1/2) and, with
+     * dashpots, M^(1/2) (d accel / d velocity) M^(-1/2) are symmetric.  dissipation_last
+     * (with affine) excepts the last component, a quadrature of the dashpots' dissipation
+     * rate v^T C v, C = -M (d accel / d velocity), the one rate that is not affine. */
     size_t n_pairs;
     const double *pair_mass;
     int affine;
+    int dissipation_last;
     /* Optional exact Jacobian d(ydot)/dy for implicit methods: calls put(matrix, row, col,
      * value) for each non-zero entry (entries for one position add up).  A banded back-end
      * drops the entries outside its band instead of approximating them by grouped
@@ -144,7 +147,7 @@ const bk_solver_backend *const *bk_solver_backends(void);
 
 extern const bk_solver_backend bk_solver_cvode_adams;
 extern const bk_solver_backend bk_solver_cvode_bdf;
-/* Exact piecewise-analytic (modal) stepper: affine problems only (Coulomb friction). */
+/* Exact piecewise-analytic (modal) stepper: affine problems only (Coulomb friction, dashpots). */
 extern const bk_solver_backend bk_solver_exact;
 /* ARKODE ARKStep (src/solver/arkode.c) */
 extern const bk_solver_backend bk_solver_arkode_bs23;

@@ -1,32 +1,63 @@
 /* Exact piecewise-analytic stepper for affine problems (Coulomb friction, linear or frozen
- * tension-only springs, a constant-velocity driver).
+ * tension-only springs, a constant-velocity driver, dashpots).
  *
  * What it computes.  Between two (re)starts the problem handed over is
  *
- *     xi'' = -K xi + a(t)          p pairs (xi, v = xi'), K = M^-1 (stiffness), constant
+ *     xi'' = -K xi - D v + a(t)    p pairs (xi, v = xi'), K = M^-1 (stiffness),
+ *                                  D = M^-1 C (dashpots), constant
  *     q'   = P xi + Q v + r(t)     quadratures (energy increments)
+ *     q_last' = v^T C v            the dashpots' dissipation, when the problem declares it
  *
- * with a and r affine in t.  start() reads K, P, Q and the affine forcing (measured from the
- * starting state, so that u = xi - xi0 starts at 0), splits the pairs into clusters (the
- * connected components of K's coupling), symmetrises each cluster's S = M^(1/2) K M^(-1/2)
- * and diagonalises it, S = U diag(w_k^2) U^T (GSL).  In the modal coordinates
- * eta = U^T M^(1/2) u each mode is an undamped oscillator with a ramp force, tau = t - t0:
+ * with a and r affine in t.  start() reads K, D, P, Q and the affine forcing (measured from
+ * the starting state, so that u = xi - xi0 starts at 0), splits the pairs into clusters (the
+ * connected components of K's and D's coupling), symmetrises each cluster's
+ * S = M^(1/2) K M^(-1/2) and diagonalises it, S = U diag(w_k^2) U^T (GSL).  When the
+ * cluster's damping is proportional, M^(1/2) D M^(-1/2) = alpha I + beta S (uniform masses
+ * and substrate dashpots; coupling dashpots in the ratio of the coupling springs on uniform
+ * driver springs; no dashpots at all), U diagonalises it too, with gamma_k = alpha +
+ * beta w_k^2, and in the modal coordinates eta = U^T M^(1/2) u each mode is a damped
+ * oscillator with a ramp force, tau = t - t0:
  *
- *     eta_k'' = -w_k^2 eta_k + g_k + d_k tau,   eta_k(0) = 0,  eta_k'(0) = c_k
- *     eta_k   = c_k phi1 + g_k phi2 + d_k phi3,  eta_k' - c_k = -w_k^2 c_k phi2 + g_k phi1 + d_k phi2
+ *     eta_k'' + gamma_k eta_k' + w_k^2 eta_k = f_k + d_k tau,  eta_k(0) = 0,  eta_k'(0) = c_k,
+ *     f_k = g_k + gamma_k c_k (g_k: the mode's acceleration at the start)
+ *     eta_k = c_k phi1 + f_k phi2 + d_k phi3,  eta_k' - c_k = -w_k^2 c_k phi2 + g_k phi1 + d_k phi2
  *
- * where phi0 = cos(w tau), phi1 = sin(w tau)/w, and phi_{j+1} is the integral of phi_j from 0,
- * so phi2 = (1 - cos)/w^2 = 2 sin^2(w tau / 2)/w^2, phi3 = (tau - phi1)/w^2,
- * phi4 = (tau^2/2 - phi2)/w^2; for w tau < 2 phi3 and phi4 come from their power series,
- * and w = 0 (or w^2 within rounding of zero relative to the cluster's largest) gives
- * tau^j / j!.  The quadratures are the integrals of their affine rates along this solution,
- * again sums of phi2..phi4, in closed form.  Every evaluation of y(t) is exact up to rounding;
- * nothing is integrated, so there is no truncation error at all.
+ * where phi1 is the mode's impulse response (phi1(0) = 0, phi1'(0) = 1) and phi_{j+1} is the
+ * integral of phi_j from 0; eta' - c keeps its undamped form because phi0 = phi1' =
+ * 1 - gamma phi1 - w^2 phi2.  Undamped, phi0 = cos(w tau), phi1 = sin(w tau)/w,
+ * phi2 = (1 - cos)/w^2 = 2 sin^2(w tau / 2)/w^2, phi3 = (tau - phi1)/w^2,
+ * phi4 = (tau^2/2 - phi2)/w^2; for w tau < 2 phi3 and phi4 come from their power series, and
+ * w = 0 (or w^2 within rounding of zero relative to the cluster's largest) gives tau^j / j!.
+ * Damped (underdamped, critical, overdamped alike), exact_damped.c: the ODE's power series
+ * where the largest characteristic root times tau is below 2, the divided difference of the
+ * two real roots where clearly overdamped, else e^(-gamma tau / 2) times sin or the expm1
+ * form of sinh of the half-difference over the frequency, and the ODE's integrated
+ * identities upward.  The quadratures are the integrals of their affine rates along this
+ * solution, again sums of phi2..phi4, in closed form; the dissipation is each damped mode's
+ * energy balance, gamma int eta'^2 = -(eta'^2 - c^2)/2 - w^2 eta^2/2 + int (f + d tau) eta'.
+ * Damping that is not proportional couples the modes (their motion is no sum of real
+ * damped oscillators): such a cluster is solved in its 2p-dimensional state space instead,
+ * by the eigenvectors of [0 I; -S -Cs] (LAPACK dgeev; complex pairs in real form) and the
+ * exponential integrators' phi-functions of each eigenvalue (exact_coupled.c), with its
+ * dissipation from its energy balance; it is refused, with the reason, only where those
+ * eigenvectors are too ill-conditioned to be accurate (two modes merging: within ~1e-9 of
+ * critical damping, or an undamped free mode).  It is no faster than gsl_rk8pd there (a
+ * 2p x 2p eigenproblem per restart, 4 p^2 per probe), so method = auto gives such scenes an
+ * integrator (bk_model_damping_proportional).  Every evaluation of y(t) is exact up to
+ * rounding; nothing is integrated, so there is no truncation error at all.
  *
  * Root functions are sampled along the exact solution at most every 1/16 of the shortest
  * modal period (and max_step); a sign change is located by GSL's Brent on the exact solution
  * to the last few representable doubles and reported with the state just after the crossing,
- * as CVODE does.  A function exactly zero at the start stays inactive until it moves away
+ * as CVODE does.  With dashpots a mode varies on the time scale of its largest
+ * characteristic root: |root| = w for an oscillating one (so 1/16 of its undamped period,
+ * shorter than 1/16 of its damped one), and for an overdamped one the slow root, and the
+ * fast root l- too until e^(l- tau) fell below e^-40 (bk_exact_sampling_step): a sampling
+ * step over which every exponential changes by at most e^(-2 pi / 16) = 0.68, as an
+ * oscillation turns by 22.5 degrees, so a sum of them cannot cross and cross back unseen any
+ * more than an undamped one can.  A function exactly zero over a stretch (a damped block's
+ * acceleration once it slides steadily, rounded to zeros) is located at its earliest zero
+ * by bisection.  A function exactly zero at the start stays inactive until it moves away
  * from zero (CVODE's convention).  A long island can have several transitions per sampling
  * step, and every probe evaluates all its root functions, so the number of probes per
  * transition is what must stay bounded: a step with several crossings is first halved toward
@@ -44,19 +75,20 @@
  * exactly those of the block-diagonal matrix, so nothing is approximated.  A chain stretch's
  * S is tridiagonal, and LAPACK's dstevr (relatively robust representations) diagonalises it
  * in O(p^2); only a ring slipping all round (cyclic S) goes through GSL's dense symmv, p^3.
- * K, P and Q come from the problem's exact Jacobian when it has one (O(p) entries, checked
+ * K, D, P and Q come from the problem's exact Jacobian when it has one (O(p) entries, checked
  * against the right-hand side by one combined probe) instead of one right-hand-side probe
  * per component, which is O(p^2).
  *
  * Why uniform clusters are special.  Blocks of equal mass, equal velocity and equal
- * acceleration whose stiffness rows sum alike (a uniform chain slipping together, its
- * couplings exactly balanced) move as one: their motion is the single oscillator of that
- * row sum.  The eigenvectors of such a cluster are exact only up to rounding, and summing
- * the modes back would give each block a slightly different motion, so a uniform chain
- * that physically slides as one would break into sub-events (seen: 3,393 transitions where
- * the integrators give 41 synchronous slips of 16 blocks).  So a uniform cluster is solved
- * as that one oscillator and every member gets the same numbers: symmetric inputs give
- * symmetric outputs, and the cost is O(p) however long the cluster. */
+ * acceleration whose stiffness rows sum alike and damping rows too (a uniform chain slipping
+ * together, its couplings exactly balanced) move as one: their motion is the single
+ * (damped) oscillator of those row sums.  The eigenvectors of such a cluster are exact only
+ * up to rounding, and summing the modes back would give each block a slightly different
+ * motion, so a uniform chain that physically slides as one would break into sub-events
+ * (seen: 3,393 transitions where the integrators give 41 synchronous slips of 16 blocks).
+ * So a uniform cluster is solved as that one oscillator and every member gets the same
+ * numbers: symmetric inputs give symmetric outputs, and the cost is O(p) however long the
+ * cluster. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -93,6 +125,10 @@ static void destroy(void *mem)
     free(eb->matrices);
     free(eb->row_col);
     free(eb->row_value);
+    free(eb->damp_col);
+    free(eb->damp_value);
+    free(eb->coupled_data);
+    free(eb->coupled_work);
     free(eb->direction);
     free(eb->sign);
     free(eb->found);
@@ -127,8 +163,12 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     if (!problem->affine)
         return BK_FAIL(err, BK_ERR_CONFIG,
                        "method exact needs Coulomb friction (constant sliding force, no friction "
-                       "state) and no dashpots (no damping)" USE_INTEGRATOR);
+                       "state) and blocks with mass" USE_INTEGRATOR);
     size_t p = problem->n_pairs;
+    if (problem->dissipation_last && 2 * p >= n)
+        return BK_FAIL(err, BK_ERR_CONFIG,
+                       "method exact: the dashpots' dissipation is declared the last component, "
+                       "but there is no quadrature after the %zu pairs (n = %zu)", p, n);
     if (2 * p > n || (p > 0 && !problem->pair_mass))
         return BK_FAIL(err, BK_ERR_CONFIG,
                        "method exact needs the state as (position, velocity) pairs followed only "
@@ -147,6 +187,8 @@ static int start(void *mem, const bk_ode_problem *problem, double t0, const doub
     eb->t_stop = t_stop;
     eb->g_try_time = NAN;
     eb->n_couplings = 0;
+    eb->n_dampings = 0;
+    eb->dissipation = problem->dissipation_last != 0;
     eb->n_clusters = 0;
     memcpy(eb->y0, y0, n * sizeof *y0);
     memset(eb->P, 0, eb->m * p * sizeof *eb->P);
@@ -235,6 +277,28 @@ static double root_value(double t, void *user)
     return g;
 }
 
+/* Function rp->index is exactly zero at hi: it may have been so since well before, where a
+ * motion settles (a damped block's acceleration once it slides steadily rounds to exact
+ * zeros), and Brent has no sign change to work with.  Bisect for the earliest time it holds
+ * zero or its new sign, to the last few doubles. */
+static int earliest_zero(root_probe *rp, int old, double lo, double hi, double *t_root)
+{
+    while (hi - lo > 2.0 * DBL_EPSILON * fmax(fabs(lo), fabs(hi))) {
+        double mid = lo + 0.5 * (hi - lo);
+        if (mid <= lo || mid >= hi)
+            break;
+        double g = root_value(mid, rp);
+        if (rp->status != BK_OK)
+            return rp->status;
+        if (g * old <= 0.0)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    *t_root = hi;
+    return BK_OK;
+}
+
 /* Locate the crossing of function i in [lo, hi] (its old sign at or before lo, its new sign
  * or zero at hi, value g_hi): *t_root is the earliest time found where it holds its new
  * sign or zero, within a few doubles of the zero. */
@@ -244,11 +308,13 @@ static int locate(exact_backend *eb, size_t i, double lo, double hi, double g_hi
     root_probe rp = {.eb = eb, .index = i, .err = err, .status = BK_OK};
     gsl_function fn = {root_value, &rp};
     int old = eb->sign[i];
-    if (g_hi == 0.0 || hi <= lo) {
+    if (hi <= lo) {
         *t_root = hi;
         return BK_OK;
     }
     remember(&rp, hi, g_hi);
+    if (g_hi == 0.0)
+        return earliest_zero(&rp, old, lo, hi, t_root);
     /* lo's value differs from the last sign seen only when it is exactly zero there: the
      * crossing is at lo. */
     double g_lo = root_value(lo, &rp);
@@ -259,10 +325,12 @@ static int locate(exact_backend *eb, size_t i, double lo, double hi, double g_hi
         return BK_OK;
     }
     for (int attempt = 0; attempt < 64; ++attempt) {
-        if (g_hi == 0.0 || hi <= lo) {
+        if (hi <= lo) {
             *t_root = hi;
             return BK_OK;
         }
+        if (g_hi == 0.0)
+            return earliest_zero(&rp, old, lo, hi, t_root);
         int rc = gsl_root_fsolver_set(eb->shared->brent, &fn, lo, hi);
         if (rp.status != BK_OK)
             return rp.status;
@@ -435,6 +503,7 @@ static int step(void *mem, double *t_reached, double *y, bk_error *err)
         *t_reached = eb->t_stop;
         return BK_STEP_STOP;
     }
+    eb->h = bk_exact_sampling_step(eb, lo);
     double hi = lo + eb->h;
     /* Never leave a sliver before the stop time. */
     if (!(hi < eb->t_stop - 1e-3 * eb->h))

@@ -1,7 +1,9 @@
 /* The exact stepper reads its problem: the affine forcing at the start and the stiffness,
- * quadrature position and velocity coefficients (K, P, Q), from the problem's exact Jacobian
- * when it has one (O(p) entries, checked by one combined right-hand-side probe), else one
- * probe per column; anything that is not affine with constant coefficients is refused. */
+ * damping, quadrature position and velocity coefficients (K, D, P, Q), from the problem's
+ * exact Jacobian when it has one (O(p) entries, checked by one combined right-hand-side
+ * probe), else one probe per column; anything that is not affine with constant coefficients
+ * is refused, but for the dashpots' dissipation v^T C v (C = M D) when the problem declares
+ * it, which is checked against D instead. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,6 +16,48 @@ static int add_coupling(exact_backend *eb, size_t row, size_t col, double value)
         return -1;
     eb->shared->couplings[eb->n_couplings++] = (coupling){row, col, value};
     return 0;
+}
+
+static int add_damping(exact_backend *eb, size_t row, size_t col, double value)
+{
+    if (bk_exact_reserve_damping(eb) != 0)
+        return -1;
+    eb->shared->dampings[eb->n_dampings++] = (coupling){row, col, value};
+    return 0;
+}
+
+/* v^T C v, C = M D: the dissipation rate the dashpots' quadrature must have at velocities
+ * v (of the pairs, stride 2 in a state vector). */
+static double dissipation_rate(const exact_backend *eb, const double *y)
+{
+    double sum = 0.0;
+    for (size_t e = 0; e < eb->n_dampings; ++e) {
+        const coupling *cp = &eb->shared->dampings[e];
+        sum += eb->problem.pair_mass[cp->row] * cp->value * y[2 * cp->row + 1] * y[2 * cp->col + 1];
+    }
+    return sum;
+}
+
+/* Its size for a tolerance: the sum of the magnitudes of its terms. */
+static double dissipation_scale(const exact_backend *eb, const double *y)
+{
+    double sum = 0.0;
+    for (size_t e = 0; e < eb->n_dampings; ++e) {
+        const coupling *cp = &eb->shared->dampings[e];
+        sum += fabs(eb->problem.pair_mass[cp->row] * cp->value * y[2 * cp->row + 1] * y[2 * cp->col + 1]);
+    }
+    return sum;
+}
+
+static int check_dissipation(const exact_backend *eb, const double *y, double rate, bk_error *err)
+{
+    double expected = dissipation_rate(eb, y);
+    if (fabs(rate - expected) > STRUCTURE_TOL * dissipation_scale(eb, y) + DBL_MIN)
+        return BK_FAIL(err, BK_ERR_CONFIG,
+                       "method exact: the last component's rate is not the dashpots' dissipation "
+                       "v^T C v the damping of the accelerations gives (%.17g vs %.17g)" USE_INTEGRATOR,
+                       rate, expected);
+    return BK_OK;
 }
 
 /* --- start: read the matrices, split into clusters, diagonalise -------------------------- */
@@ -50,15 +94,6 @@ static int rhs_checked(exact_backend *eb, double t, const double *y, double *ydo
 {
     int rc = call_rhs(eb, t, y, ydot, err);
     return rc != BK_OK ? rc : check_kinematics(eb, y, ydot, err);
-}
-
-static int refuse_velocity(size_t pair, size_t velocity_of, bk_error *err)
-{
-    return BK_FAIL(err, BK_ERR_CONFIG,
-                   "method exact: the acceleration of pair %zu depends on the velocity of pair %zu "
-                   "(velocity-dependent friction or damping); it needs Coulomb friction (constant "
-                   "sliding force, no friction state)" USE_INTEGRATOR,
-                   pair, velocity_of);
 }
 
 static int refuse_quadrature(size_t component, size_t quadrature, bk_error *err)
@@ -100,6 +135,8 @@ static int probe_forcing(exact_backend *eb, bk_error *err)
         eb->accel_rate[i] = (f[2 * i + 1] - f0[2 * i + 1]) / dt;
     for (size_t j = 0; j < m; ++j)
         eb->q_rate[j] = (f[2 * p + j] - f0[2 * p + j]) / dt;
+    if (eb->dissipation) /* computed from the modes' energy balance instead */
+        eb->qdot0[m - 1] = eb->q_rate[m - 1] = 0.0;
     return BK_OK;
 }
 
@@ -128,20 +165,43 @@ static int probe_columns(exact_backend *eb, bk_error *err)
             eb->P[j * p + l] = delta / h;
             scale[2 * p + j] += fabs(delta);
         }
+        /* the dissipation must not move with a position (D is not known yet, but its value
+         * at these velocities is the one at the start) */
+        if (eb->dissipation && fabs(f[n - 1] - f0[n - 1]) > STRUCTURE_TOL * (fabs(f0[n - 1]) + DBL_MIN))
+            return BK_FAIL(err, BK_ERR_CONFIG,
+                           "method exact: the last component's rate, declared the dashpots' "
+                           "dissipation, depends on position %zu" USE_INTEGRATOR, l);
     }
-    /* Velocities: accelerations must not depend on them; columns of Q. */
+    /* Velocities: columns of D (dashpots) and of Q; the dissipation's rates at these probes
+     * kept (in delta) for its check once D is complete. */
+    size_t affine_m = m - (size_t)eb->dissipation;
     for (size_t l = 0; l < p; ++l) {
         double h = perturb(eb, 2 * l + 1);
         if ((rc = rhs_checked(eb, t0, eb->scratch, f, err)) != BK_OK)
             return rc;
-        for (size_t i = 0; i < p; ++i)
-            if (fabs(f[2 * i + 1] - f0[2 * i + 1]) > STRUCTURE_TOL * scale[2 * i + 1])
-                return refuse_velocity(i, l, err);
-        for (size_t j = 0; j < m; ++j) {
+        for (size_t i = 0; i < p; ++i) {
+            double delta = f[2 * i + 1] - f0[2 * i + 1];
+            if (fabs(delta) > STRUCTURE_TOL * scale[2 * i + 1] && add_damping(eb, i, l, -delta / h) != 0)
+                return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for the dashpots");
+        }
+        for (size_t j = 0; j < affine_m; ++j) {
             double delta = f[2 * p + j] - f0[2 * p + j];
             eb->Q[j * p + l] = delta / h;
             scale[2 * p + j] += fabs(delta);
         }
+        if (eb->dissipation)
+            eb->delta[l] = f[n - 1];
+    }
+    if (eb->dissipation) {
+        if ((rc = check_dissipation(eb, eb->y0, f0[n - 1], err)) != BK_OK)
+            return rc;
+        for (size_t l = 0; l < p && rc == BK_OK; ++l) {
+            perturb(eb, 2 * l + 1);
+            rc = check_dissipation(eb, eb->scratch, eb->delta[l], err);
+        }
+        if (rc != BK_OK)
+            return rc;
+        memset(&eb->P[(m - 1) * p], 0, p * sizeof *eb->P);
     }
     /* Quadratures: nothing may depend on them. */
     for (size_t j = 0; j < m; ++j) {
@@ -155,8 +215,9 @@ static int probe_columns(exact_backend *eb, bk_error *err)
     return BK_OK;
 }
 
-/* The Jacobian's put(): K into couplings, P and Q; position rows are left to the kinematics
- * check of the verifying probe. */
+/* The Jacobian's put(): K into couplings, D into dampings, P and Q; position rows are left
+ * to the kinematics check of the verifying probe, and the dissipation's row (its gradient at
+ * y0, not a constant) to that probe's check of v^T C v. */
 static void put_entry(void *matrix, size_t row, size_t col, double value)
 {
     exact_backend *eb = matrix;
@@ -168,10 +229,12 @@ static void put_entry(void *matrix, size_t row, size_t col, double value)
         status = JACOBIAN_RANGE;
     else if (row < 2 * p && row % 2 == 0)
         return;
+    else if (eb->dissipation && row == eb->n - 1 && col < 2 * p)
+        return;
     else if (col >= 2 * p)
         status = JACOBIAN_QUADRATURE;
     else if (row < 2 * p && col % 2 == 1)
-        status = JACOBIAN_VELOCITY;
+        status = add_damping(eb, row / 2, col / 2, -value) == 0 ? JACOBIAN_OK : JACOBIAN_NOMEM;
     else if (row < 2 * p)
         status = add_coupling(eb, row / 2, col / 2, -value) == 0 ? JACOBIAN_OK : JACOBIAN_NOMEM;
     else
@@ -201,8 +264,6 @@ static int read_jacobian(exact_backend *eb, bk_error *err)
     case JACOBIAN_RANGE:
         return BK_FAIL(err, BK_ERR_SOLVER, "exact stepper: Jacobian entry (%zu, %zu) outside the %zu "
                        "components", eb->bad_row, eb->bad_col, n);
-    case JACOBIAN_VELOCITY:
-        return refuse_velocity(eb->bad_row / 2, eb->bad_col / 2, err);
     case JACOBIAN_QUADRATURE:
         return refuse_quadrature(eb->bad_row, eb->bad_col, err);
     default:
@@ -223,6 +284,12 @@ static int read_jacobian(exact_backend *eb, bk_error *err)
         predicted[2 * cp->row + 1] += change;
         size[2 * cp->row + 1] += fabs(change);
     }
+    for (size_t e = 0; e < eb->n_dampings; ++e) {
+        const coupling *cp = &eb->shared->dampings[e];
+        double change = -cp->value * delta[2 * cp->col + 1];
+        predicted[2 * cp->row + 1] += change;
+        size[2 * cp->row + 1] += fabs(change);
+    }
     for (size_t j = 0; j < m; ++j)
         for (size_t l = 0; l < p; ++l) {
             double change = eb->P[j * p + l] * delta[2 * l] + eb->Q[j * p + l] * delta[2 * l + 1];
@@ -233,7 +300,10 @@ static int read_jacobian(exact_backend *eb, bk_error *err)
     double *f = eb->probe;
     if ((rc = rhs_checked(eb, eb->t0, eb->scratch, f, err)) != BK_OK)
         return rc;
-    for (size_t k = 0; k < n; ++k) {
+    if (eb->dissipation && ((rc = check_dissipation(eb, eb->y0, f0[n - 1], err)) != BK_OK ||
+                            (rc = check_dissipation(eb, eb->scratch, f[n - 1], err)) != BK_OK))
+        return rc;
+    for (size_t k = 0; k < n - (size_t)eb->dissipation; ++k) {
         if (k < 2 * p && k % 2 == 0)
             continue;
         if (fabs(f[k] - predicted[k]) > STRUCTURE_TOL * (size[k] + fabs(f[k] - f0[k])))

@@ -46,7 +46,10 @@ static void basis(double w, double tau, double phi[5])
     }
 }
 
-/* Every mode's eta, eta' - c and their integrals at tau = t - t0: O(p). */
+/* Every mode's eta, eta' - c and their integrals at tau = t - t0: O(p).  A damped mode's
+ * forcing at the start is g + gamma c (g is its acceleration there, which the dashpot's
+ * -gamma c already holds); eta' - c and its integral keep the undamped forms (exact.c's
+ * header). */
 void bk_exact_modal_amplitudes(exact_backend *eb, double tau)
 {
     for (size_t k = 0; k < eb->p; ++k) {
@@ -55,21 +58,32 @@ void bk_exact_modal_amplitudes(exact_backend *eb, double tau)
             eb->eta[k] = eb->deta[k] = eb->ieta[k] = eb->idv[k] = 0.0;
             continue;
         }
-        double phi[5], w2 = eb->omega2[k];
-        basis(eb->omega[k], tau, phi);
-        eb->eta[k] = ck * phi[1] + gk * phi[2] + dk * phi[3];
+        double phi[5], w2 = eb->omega2[k], gamma = eb->gamma[k];
+        if (gamma == 0.0)
+            basis(eb->omega[k], tau, phi);
+        else
+            bk_exact_damped_basis(w2, gamma, eb->root[k], eb->radius[k], tau, phi);
+        double forcing = gk + gamma * ck;
+        eb->eta[k] = ck * phi[1] + forcing * phi[2] + dk * phi[3];
         eb->deta[k] = -w2 * ck * phi[2] + gk * phi[1] + dk * phi[2];
-        eb->ieta[k] = ck * phi[2] + gk * phi[3] + dk * phi[4];
+        eb->ieta[k] = ck * phi[2] + forcing * phi[3] + dk * phi[4];
         eb->idv[k] = (dk - w2 * ck) * phi[3] + gk * phi[2];
     }
+    if (eb->n_coupled > 0)
+        bk_exact_coupled_amplitudes(eb, tau);
 }
 
-/* Cluster cl's pairs from the amplitudes: O(size) for a uniform cluster, else O(size^2). */
+/* Cluster cl's pairs from the amplitudes: O(size) for a uniform cluster, else O(size^2)
+ * (4 size^2 for a coupled one). */
 void bk_exact_cluster_state(const exact_backend *eb, size_t cl, double *y)
 {
     size_t first = eb->first[cl], size = eb->first[cl + 1] - first;
     const double *T = &eb->T[eb->offset[cl]];
     const double *eta = &eb->eta[first], *deta = &eb->deta[first];
+    if (eb->coupled[cl]) {
+        bk_exact_coupled_state(eb, cl, y);
+        return;
+    }
     if (eb->uniform[cl]) {
         for (size_t r = 0; r < size; ++r) {
             size_t i = eb->members[first + r];
@@ -91,17 +105,44 @@ void bk_exact_cluster_state(const exact_backend *eb, size_t cl, double *y)
     }
 }
 
+/* The dashpots' dissipation from each damped mode's energy balance: multiplying
+ * eta'' + gamma eta' + w^2 eta = f(tau) by eta' and integrating,
+ *     gamma int eta'^2 = -(eta'^2 - c^2) / 2 - w^2 eta^2 / 2 + int f eta'
+ *                      = -deta (2 c + deta) / 2 - w^2 eta^2 / 2 + f0 eta + d (tau eta - ieta),
+ * f0 = g + gamma c, and the cluster's v^T C v is the sum of gamma_k eta_k'^2 (C is diagonal
+ * in the modes), weighted by the mode's mass (1 in mass-normalised coordinates).  No
+ * quadrature of its own is needed, and it is exact like the rest: O(p). */
+static double dissipation(const exact_backend *eb, double tau)
+{
+    double sum = 0.0;
+    for (size_t k = 0; k < eb->p; ++k) {
+        if (eb->gamma[k] == 0.0)
+            continue;
+        double ck = eb->c[k], eta = eb->eta[k], deta = eb->deta[k];
+        double forcing = eb->g[k] + eb->gamma[k] * ck;
+        double balance = -0.5 * deta * (2.0 * ck + deta) - 0.5 * eb->omega2[k] * eta * eta +
+                         forcing * eta + eb->d[k] * (tau * eta - eb->ieta[k]);
+        sum += eb->mode_mass[k] * balance;
+    }
+    return sum;
+}
+
 /* The quadratures from the amplitudes: O(m p). */
 void bk_exact_quadratures(const exact_backend *eb, double tau, double *y)
 {
-    size_t p = eb->p;
-    for (size_t j = 0; j < eb->m; ++j) {
+    size_t p = eb->p, affine_m = eb->m - (size_t)eb->dissipation;
+    for (size_t j = 0; j < affine_m; ++j) {
         const double *Pj = &eb->P_modal[j * p], *Qj = &eb->Q_modal[j * p];
         double sum = 0.0;
         for (size_t k = 0; k < p; ++k)
             sum += Pj[k] * eb->ieta[k] + Qj[k] * eb->idv[k];
+        if (eb->n_coupled > 0)
+            sum += bk_exact_coupled_quadrature(eb, j);
         y[2 * p + j] = eb->y0[2 * p + j] + (eb->qdot0[j] + 0.5 * eb->q_rate[j] * tau) * tau + sum;
     }
+    if (eb->dissipation)
+        y[eb->n - 1] = eb->y0[eb->n - 1] + dissipation(eb, tau) +
+                       (eb->n_coupled > 0 ? bk_exact_coupled_dissipation(eb, tau) : 0.0);
 }
 
 /* The exact state at time t into y (size n): O(p) modes, O(sum p_i^2) back to the pairs. */
@@ -127,6 +168,12 @@ static int reserve_matrices(exact_backend *eb, size_t total, size_t largest, bk_
     return bk_exact_reserve_work(eb, largest, err);
 }
 
+static int descending(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x < y) - (x > y);
+}
+
 static size_t find_set(size_t *parent, size_t i)
 {
     while (parent[i] != i) {
@@ -137,8 +184,8 @@ static size_t find_set(size_t *parent, size_t i)
 }
 
 /* Cluster k moves as one: two or more pairs of equal mass, equal starting velocity, equal
- * acceleration and equal rate of it, whose rows of K sum alike (to rounding: the ends of a
- * free chain sum their couplings in another order). */
+ * acceleration and equal rate of it, whose rows of K sum alike and rows of D too (to
+ * rounding: the ends of a free chain sum their couplings in another order). */
 static int uniform_cluster(const exact_backend *eb, size_t k)
 {
     size_t first = eb->first[k], size = eb->first[k + 1] - first;
@@ -153,24 +200,34 @@ static int uniform_cluster(const exact_backend *eb, size_t k)
         double scale = fmax(eb->row_scale[i], eb->row_scale[a]);
         if (fabs(eb->row_sum[i] - eb->row_sum[a]) > 16.0 * DBL_EPSILON * scale)
             return 0;
+        /* the dashpots too: the same damping force on every member moving alike */
+        double damp_scale = fmax(eb->damp_scale[i], eb->damp_scale[a]);
+        if (fabs(eb->damp_sum[i] - eb->damp_sum[a]) > 16.0 * DBL_EPSILON * damp_scale)
+            return 0;
     }
     return 1;
 }
 
-/* Clusters: connected components of K's couplings (a set's root is its smallest pair), in
- * the order of their first pairs; each cluster's S assembled densely. */
+static void join(size_t *parent, const coupling *cp)
+{
+    size_t a = find_set(parent, cp->row), b = find_set(parent, cp->col);
+    if (a < b)
+        parent[b] = a;
+    else if (b < a)
+        parent[a] = b;
+}
+
+/* Clusters: connected components of K's and D's couplings (a set's root is its smallest
+ * pair), in the order of their first pairs; each cluster's S assembled densely. */
 static int split_clusters(exact_backend *eb, bk_error *err)
 {
     size_t p = eb->p, *parent = eb->parent;
     for (size_t i = 0; i < p; ++i)
         parent[i] = i;
-    for (size_t e = 0; e < eb->n_couplings; ++e) {
-        size_t a = find_set(parent, eb->shared->couplings[e].row), b = find_set(parent, eb->shared->couplings[e].col);
-        if (a < b)
-            parent[b] = a;
-        else if (b < a)
-            parent[a] = b;
-    }
+    for (size_t e = 0; e < eb->n_couplings; ++e)
+        join(parent, &eb->shared->couplings[e]);
+    for (size_t e = 0; e < eb->n_dampings; ++e)
+        join(parent, &eb->shared->dampings[e]);
     size_t count = 0;
     for (size_t i = 0; i < p; ++i) {
         size_t root = find_set(parent, i);
@@ -205,6 +262,13 @@ static int split_clusters(exact_backend *eb, bk_error *err)
         eb->row_sum[cp->row] += cp->value;
         eb->row_scale[cp->row] = fmax(eb->row_scale[cp->row], fabs(cp->value));
     }
+    for (size_t i = 0; i < p; ++i)
+        eb->damp_sum[i] = eb->damp_scale[i] = 0.0;
+    for (size_t e = 0; e < eb->n_dampings; ++e) {
+        const coupling *cp = &eb->shared->dampings[e];
+        eb->damp_sum[cp->row] += cp->value;
+        eb->damp_scale[cp->row] = fmax(eb->damp_scale[cp->row], fabs(cp->value));
+    }
     /* Matrix offsets: a uniform cluster needs none. */
     size_t total = 0, largest = 0;
     for (size_t k = 0; k < count; ++k) {
@@ -220,12 +284,20 @@ static int split_clusters(exact_backend *eb, bk_error *err)
     int rc = reserve_matrices(eb, total, largest, err);
     if (rc != BK_OK)
         return rc;
-    memset(eb->S, 0, total * sizeof *eb->S);
+    memset(eb->S, 0, 2 * total * sizeof *eb->S);
     for (size_t e = 0; e < eb->n_couplings; ++e) {
         const coupling *cp = &eb->shared->couplings[e];
         size_t k = eb->cluster_of[cp->row], size = eb->first[k + 1] - eb->first[k];
         if (!eb->uniform[k])
             eb->S[eb->offset[k] + eb->local[cp->row] * size + eb->local[cp->col]] += cp->value;
+    }
+    /* D symmetrised, M^(1/2) D M^(-1/2), into T for proportional_damping */
+    for (size_t e = 0; e < eb->n_dampings; ++e) {
+        const coupling *cp = &eb->shared->dampings[e];
+        size_t k = eb->cluster_of[cp->row], size = eb->first[k + 1] - eb->first[k];
+        if (!eb->uniform[k])
+            eb->T[eb->offset[k] + eb->local[cp->row] * size + eb->local[cp->col]] +=
+                cp->value * eb->sqrt_mass[cp->row] / eb->sqrt_mass[cp->col];
     }
     return BK_OK;
 }
@@ -307,9 +379,20 @@ static int uniform_modes(exact_backend *eb, size_t k, bk_error *err)
                        first, l);
     if (l <= ZERO_MODE * eb->row_scale[a])
         l = 0.0;
+    double gamma = eb->damp_sum[a], mass = 0.0;
+    if (gamma < -ZERO_MODE * eb->damp_scale[a])
+        return BK_FAIL(err, BK_ERR_CONFIG,
+                       "method exact: mode %zu has negative damping (%.6g s^-1)" USE_INTEGRATOR, first,
+                       gamma);
+    if (gamma <= ZERO_MODE * eb->damp_scale[a])
+        gamma = 0.0;
+    for (size_t r = 0; r < size; ++r)
+        mass += eb->problem.pair_mass[members[r]];
     for (size_t q = 0; q < size; ++q) {
         eb->omega2[first + q] = l;
         eb->omega[first + q] = sqrt(l);
+        eb->gamma[first + q] = gamma;
+        eb->mode_mass[first + q] = mass;
         eb->c[first + q] = q == 0 ? eb->y0[2 * a + 1] : 0.0;
         eb->g[first + q] = q == 0 ? eb->accel0[a] : 0.0;
         eb->d[first + q] = q == 0 ? eb->accel_rate[a] : 0.0;
@@ -327,6 +410,51 @@ static int uniform_modes(exact_backend *eb, size_t k, bk_error *err)
         }
     }
     return BK_OK;
+}
+
+/* Whether cluster k's damping in the symmetrised coordinates, Cs = M^(1/2) D M^(-1/2)
+ * (assembled in its T by split_clusters; the eigenvectors overwrite it after), is
+ * alpha I + beta S (S symmetrised already, largest entry s_max): then U diagonalises both and
+ * each mode is one damped oscillator, gamma_k = alpha + beta w_k^2.  That is the case of
+ * uniform masses with uniform dashpots to the substrate, and of coupling dashpots in the
+ * ratio of the coupling springs (C = alpha M + beta K_springs) with uniform driver springs.
+ * Other damping couples the modes (their motion is not a sum of real damped oscillators):
+ * 0, and exact_coupled.c solves the cluster in its state space. */
+static int proportional_damping(const exact_backend *eb, size_t k, double s_max, double *alpha, double *beta)
+{
+    size_t first = eb->first[k], size = eb->first[k + 1] - first;
+    const double *S = &eb->S[eb->offset[k]];
+    double *Cs = &eb->T[eb->offset[k]];
+    *alpha = *beta = 0.0;
+    double c_max = 0.0;
+    size_t r_big = 0, q_big = 0;
+    double s_off = 0.0;
+    for (size_t r = 0; r < size; ++r)
+        for (size_t q = 0; q < size; ++q) {
+            c_max = fmax(c_max, fabs(Cs[r * size + q]));
+            if (r != q && fabs(S[r * size + q]) > s_off) {
+                s_off = fabs(S[r * size + q]);
+                r_big = r;
+                q_big = q;
+            }
+        }
+    /* beta from the largest coupling, alpha from the diagonal's mean */
+    if (c_max == 0.0)
+        return 1;
+    if (s_off > 0.0)
+        *beta = 0.5 * (Cs[r_big * size + q_big] + Cs[q_big * size + r_big]) / S[r_big * size + q_big];
+    double mean = 0.0;
+    for (size_t r = 0; r < size; ++r)
+        mean += Cs[r * size + r] - *beta * S[r * size + r];
+    *alpha = mean / (double)size;
+    double tol = PROPORTIONAL_TOL * (c_max + fabs(*beta) * s_max);
+    for (size_t r = 0; r < size; ++r)
+        for (size_t q = 0; q < size; ++q) {
+            double fit = (r == q ? *alpha : 0.0) + *beta * S[r * size + q];
+            if (fabs(Cs[r * size + q] - fit) > tol)
+                return 0;
+        }
+    return 1;
 }
 
 static int cluster_modes(exact_backend *eb, size_t k, bk_error *err)
@@ -352,6 +480,19 @@ static int cluster_modes(exact_backend *eb, size_t k, bk_error *err)
                                members[r], members[q], a, b);
             S[r * size + q] = S[q * size + r] = 0.5 * (a + b);
         }
+    double alpha, beta;
+    if (!proportional_damping(eb, k, s_max, &alpha, &beta)) {
+        /* exact_coupled.c takes it once every other cluster is done; its mode slots idle */
+        eb->coupled[k] = 1;
+        eb->n_coupled++;
+        for (size_t q = first; q < first + size; ++q) {
+            eb->omega2[q] = eb->omega[q] = eb->gamma[q] = 0.0;
+            eb->c[q] = eb->g[q] = eb->d[q] = eb->mode_mass[q] = 0.0;
+            for (size_t j = 0; j < eb->m; ++j)
+                eb->P_modal[j * eb->p + q] = eb->Q_modal[j * eb->p + q] = 0.0;
+        }
+        return BK_OK;
+    }
     double *omega2 = &eb->omega2[first];
     int rc = eigen_decompose(eb, S, size, omega2, T, err);
     if (rc != BK_OK)
@@ -370,6 +511,15 @@ static int cluster_modes(exact_backend *eb, size_t k, bk_error *err)
             l = 0.0;
         omega2[q] = l;
         eb->omega[first + q] = sqrt(l);
+        /* the scale alpha + beta lambda_max stands for: a mode whose damping is below its
+         * rounding is undamped, and one clearly negative is refused */
+        double gamma = alpha + beta * l, scale = fabs(alpha) + fabs(beta) * lambda_max;
+        if (gamma < -PROPORTIONAL_TOL * scale)
+            return BK_FAIL(err, BK_ERR_CONFIG,
+                           "method exact: mode %zu has negative damping (%.6g s^-1)" USE_INTEGRATOR,
+                           first + q, gamma);
+        eb->gamma[first + q] = gamma <= PROPORTIONAL_TOL * scale ? 0.0 : gamma;
+        eb->mode_mass[first + q] = 1.0;
     }
     for (size_t q = 0; q < size; ++q) {
         double c = 0.0, g = 0.0, d = 0.0;
@@ -413,25 +563,63 @@ int bk_exact_modes(exact_backend *eb, bk_error *err)
             return BK_FAIL(err, BK_ERR_INVALID, "exact stepper: pair %zu has mass %g", i, mass);
         eb->sqrt_mass[i] = sqrt(mass);
     }
+    eb->n_coupled = 0;
     int rc = split_clusters(eb, err);
-    for (size_t k = 0; k < eb->n_clusters && rc == BK_OK; ++k)
+    for (size_t k = 0; k < eb->n_clusters && rc == BK_OK; ++k) {
+        eb->coupled[k] = 0;
         rc = cluster_modes(eb, k, err);
+    }
     if (rc != BK_OK)
         return rc;
-    double lambda_max = 0.0;
-    for (size_t k = 0; k < p; ++k)
-        lambda_max = fmax(lambda_max, eb->omega2[k]);
-    /* Sampling step: a sixteenth of the shortest period, max_step, else a sixteenth of the
-     * span (polynomial motion only). */
-    double h = lambda_max > 0.0 ? 2.0 * PI / (SAMPLES_PER_PERIOD * sqrt(lambda_max)) : INFINITY;
+    /* Sampling: a sixteenth of 2 pi over the fastest rate any mode varies at (exact.c's
+     * header): an oscillating mode's |root| = w, an overdamped one's slow root while its fast
+     * one, kept apart (descending), counts only until it decayed. */
+    double rate_max = 0.0;
+    eb->n_fast = eb->fast_live = 0;
+    for (size_t k = 0; k < p; ++k) {
+        if (eb->gamma[k] == 0.0) {
+            eb->root[k] = eb->radius[k] = eb->omega[k];
+            rate_max = fmax(rate_max, eb->omega[k]);
+            continue;
+        }
+        bk_exact_damped_root(eb->omega2[k], eb->gamma[k], &eb->root[k], &eb->radius[k]);
+        if (eb->root[k] < 0.0) {
+            double sigma = 0.5 * eb->gamma[k], mu = -eb->root[k];
+            rate_max = fmax(rate_max, eb->omega2[k] / (sigma + mu));
+            eb->fast[eb->n_fast++] = eb->radius[k];
+        } else {
+            rate_max = fmax(rate_max, eb->radius[k]);
+        }
+    }
+    if (eb->n_coupled > 0 && (rc = bk_exact_coupled_modes(eb, &rate_max, err)) != BK_OK)
+        return rc;
+    qsort(eb->fast, eb->n_fast, sizeof *eb->fast, descending);
+    double h = rate_max > 0.0 ? 2.0 * PI / (SAMPLES_PER_PERIOD * rate_max) : INFINITY;
     double max_step = eb->max_step;
     if (isfinite(max_step) && max_step > 0.0 && max_step < h)
         h = max_step;
     if (!isfinite(h)) {
+        /* polynomial motion only, or decay alone: a sixteenth of the span */
         double span = eb->t_stop - eb->t0;
         h = isfinite(span) && span > 0.0 ? span / SAMPLES_PER_PERIOD : 1.0 + fabs(eb->t0);
     }
-    eb->h = h;
+    eb->h_slow = h;
+    eb->h = bk_exact_sampling_step(eb, eb->t0);
     return BK_OK;
 }
 
+/* The step from t: h_slow, or a sixteenth of 2 pi over the fastest overdamped decay rate l
+ * whose exponential has not yet fallen below e^-FAST_DECAYED (l (t - t0) < FAST_DECAYED).
+ * Within such a step e^(-l tau) changes by a factor e^(-2 pi / 16) = 0.68 at most, as an
+ * oscillation turns by 22.5 degrees, so a root function, a sum of such exponentials,
+ * oscillations and a polynomial, cannot cross and cross back unseen any more than an
+ * undamped one can; once the exponential decayed it cannot move a root function at all. */
+double bk_exact_sampling_step(exact_backend *eb, double t)
+{
+    double tau = t - eb->t0;
+    while (eb->fast_live < eb->n_fast && eb->fast[eb->fast_live] * tau >= FAST_DECAYED)
+        eb->fast_live++;
+    if (eb->fast_live == eb->n_fast)
+        return eb->h_slow;
+    return fmin(eb->h_slow, 2.0 * PI / (SAMPLES_PER_PERIOD * eb->fast[eb->fast_live]));
+}

@@ -18,6 +18,7 @@ void bk_exact_shared_release(exact_shared *s)
     free(s->modes);
     free(s->indices);
     free(s->couplings);
+    free(s->dampings);
     free(s);
     thread_shared = NULL;
 }
@@ -48,6 +49,17 @@ int bk_exact_reserve_coupling(exact_backend *eb)
     if (!couplings)
         return -1;
     s->couplings = couplings;
+    return 0;
+}
+
+int bk_exact_reserve_damping(exact_backend *eb)
+{
+    exact_shared *s = eb->shared;
+    coupling *dampings =
+        bk_grow_array(s->dampings, &s->dampings_cap, eb->n_dampings + 1, sizeof *dampings, 256);
+    if (!dampings)
+        return -1;
+    s->dampings = dampings;
     return 0;
 }
 
@@ -84,7 +96,7 @@ int bk_exact_reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_r
     eb->local = s->indices + p + 1;
     eb->parent = s->indices + 2 * (p + 1);
 
-    size_t need = 2 * n + 21 * p + 4 * m * p + 2 * m + 2;
+    size_t need = 2 * n + 29 * p + 4 * m * p + 2 * m + 2;
     double *arena = bk_fit_buffer(eb->arena, &eb->arena_cap, need, sizeof *arena);
     if (!arena)
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu components", n);
@@ -95,6 +107,11 @@ int bk_exact_reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_r
     eb->sqrt_mass = a, a += p;
     eb->omega2 = a, a += p;
     eb->omega = a, a += p;
+    eb->gamma = a, a += p;
+    eb->root = a, a += p;
+    eb->radius = a, a += p;
+    eb->mode_mass = a, a += p;
+    eb->fast = a, a += 2 * p;
     eb->c = a, a += p;
     eb->g = a, a += p;
     eb->d = a, a += p;
@@ -106,6 +123,8 @@ int bk_exact_reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_r
     eb->accel_rate = a, a += p;
     eb->row_sum = a, a += p;
     eb->row_scale = a, a += p;
+    eb->damp_sum = a, a += p;
+    eb->damp_scale = a, a += p;
     eb->yc = a, a += 2 * p;
     eb->even = a, a += p;
     eb->odd = a, a += p;
@@ -119,7 +138,7 @@ int bk_exact_reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_r
     eb->qdot0 = a, a += m;
     eb->q_rate = a;
 
-    size_t *own_indices = bk_fit_buffer(eb->indices, &eb->indices_cap, 6 * (p + 1), sizeof *own_indices);
+    size_t *own_indices = bk_fit_buffer(eb->indices, &eb->indices_cap, 8 * (p + 1), sizeof *own_indices);
     if (!own_indices)
         return BK_FAIL(err, BK_ERR_NOMEM, "exact stepper: out of memory for %zu pairs", p);
     eb->indices = own_indices;
@@ -129,7 +148,9 @@ int bk_exact_reserve(exact_backend *eb, size_t n, size_t p, size_t m, size_t n_r
     eb->offset = ix, ix += p + 1;
     eb->uniform = ix, ix += p + 1;
     eb->series = ix, ix += p + 1;
-    eb->row_start = ix;
+    eb->coupled = ix, ix += p + 1;
+    eb->row_start = ix, ix += p + 1;
+    eb->damp_start = ix;
 
     if (n_roots > 0 && !bk_capacity_fits(n_roots, eb->roots_cap)) {
         free(eb->direction);
