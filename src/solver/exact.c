@@ -436,12 +436,17 @@ static int find_roots(exact_backend *eb, double lo, double hi, double *t_root, b
         if (rc != BK_OK)
             return rc;
         double tol = 100.0 * DBL_EPSILON * (fabs(first) + eb->h);
-        /* Another function crossed before this one's window: that crossing comes first. */
+        /* Another function crossed before this one's window: that crossing comes first.  The
+         * located one itself crossed there too only when it flickers about zero at its
+         * rounding (a slip acceleration that has decayed to 1e-12 of the forces on a chain
+         * sliding steadily): no earlier zero of it means more than this one, and moving the
+         * window back for it would creep toward lo by one tolerance per round. */
         double before = first - tol;
         if (before > lo) {
             if ((rc = roots_at(eb, before, err)) != BK_OK)
                 return rc;
-            if (count_crossed(eb, eb->g_try) > 0) {
+            size_t others = count_crossed(eb, eb->g_try) - (size_t)crossed(eb, pick, eb->g_try[pick]);
+            if (others > 0) {
                 hi = before;
                 memcpy(g, eb->g_try, nr * sizeof *g);
                 continue;
