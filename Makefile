@@ -70,8 +70,11 @@ test-long: $(LONG_TESTS)
 
 # Tests run from the repository root (they read configs/ and need ./bksim for CLI tests).
 test: test-plain
+# Two programs at a time (a 2-core machine's), those that time kills and wall clocks against
+# the machine alone after them, as test-valgrind does.
 test-plain: bksim build/bench/bksim_bench build/bench/h5_plain build/bench/exact_rows $(TESTS)
-	@scripts/run_tests.sh build/tests $(TESTS)
+	@TEST_JOBS=2 TEST_ALONE="test_cli_restart test_sweep test_extremes test_h5_writer test_cli_extend" \
+	 scripts/run_tests.sh build/tests $(TESTS)
 # Every program again under the sanitizers (CI runs it); the CLI tests run the sanitizer
 # build of bksim too (BKSIM, relative to the repository root).
 test-asan: build-asan/bksim build/bench/bksim_bench build/bench/h5_plain build/bench/exact_rows $(TESTS_ASAN)
@@ -85,7 +88,7 @@ test-asan: build-asan/bksim build/bench/bksim_bench build/bench/h5_plain build/b
 # that time kills and wall clocks against the machine run alone after them.
 VALGRIND_FIRST := build/tests/test_run_catalog build/tests/test_backends
 test-valgrind: bksim $(TESTS)
-	@TEST_JOBS=2 TEST_ALONE="test_cli_restart test_sweep test_extremes test_h5_writer" BK_TEST_TIME_SCALE=200 \
+	@TEST_JOBS=2 TEST_ALONE="test_cli_restart test_sweep test_extremes test_h5_writer test_cli_extend" BK_TEST_TIME_SCALE=200 \
 	 VALGRIND="valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible --show-leak-kinds=definite,indirect,possible" \
 	 scripts/run_tests.sh valgrind $(filter $(VALGRIND_FIRST),$(TESTS)) $(filter-out $(VALGRIND_FIRST),$(TESTS))
 

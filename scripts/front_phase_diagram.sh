@@ -11,14 +11,15 @@
 # plane, log alpha, coloured by the speed and by beta, arrested fronts marked); prints the
 # table and the figures' paths.
 # usage: scripts/front_phase_diagram.sh [-j JOBS] [-o DIR] [--format png|pdf|svg]
-#                                       [--taus LIST] [--alphas LIST]
+#                                       [--taus LIST] [--alphas LIST] [--t-end T]
 #   LIST   comma-separated values (defaults: tau_bar 0.01,0.05,0.1,0.2,0.3,0.5,0.7,0.8,0.9,0.95;
 #          alpha 0.01,0.03,0.1,0.3,1,3,10)
+#   T      each run's length in unit times (default 2000: the slowest fronts that cross need it)
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 cd "$BK_REPO"
 jobs=$(nproc) dir=out/sweeps/fronts format=png
-taus=0.01,0.05,0.1,0.2,0.3,0.5,0.7,0.8,0.9,0.95 alphas=0.01,0.03,0.1,0.3,1,3,10
+taus=0.01,0.05,0.1,0.2,0.3,0.5,0.7,0.8,0.9,0.95 alphas=0.01,0.03,0.1,0.3,1,3,10 t_end=2000
 while [ $# -gt 0 ]; do
     case $1 in
         -j) bk_need_value $# "$1"; jobs=$2; shift 2 ;;
@@ -26,6 +27,7 @@ while [ $# -gt 0 ]; do
         --format) bk_need_value $# "$1"; format=$2; shift 2 ;;
         --taus) bk_need_value $# "$1"; taus=$2; shift 2 ;;
         --alphas) bk_need_value $# "$1"; alphas=$2; shift 2 ;;
+        --t-end) bk_need_value $# "$1"; t_end=$2; shift 2 ;;
         -h|--help) bk_help ;;
         *) bk_usage "unknown option '$1'" ;;
     esac
@@ -33,6 +35,8 @@ done
 list='^[0-9.eE+-]+(,[0-9.eE+-]+)*$'
 [[ $taus =~ $list ]] || bk_usage "--taus needs comma-separated numbers, got '$taus'"
 [[ $alphas =~ $list ]] || bk_usage "--alphas needs comma-separated numbers, got '$alphas'"
+[[ $t_end =~ ^[0-9.]+([eE][-+]?[0-9]+)?$ ]] && awk -v t="$t_end" 'BEGIN {exit !(t > 0)}' ||
+    bk_usage "--t-end needs a time > 0, got '$t_end'"
 bk_terminal terminal "$format"
 bk_need_command gnuplot gnuplot-nox
 bk_find_bksim bksim
@@ -41,7 +45,7 @@ export BKSIM=$bksim
 # tau_bar is applied_force - 1 (the config says why); slow fronts need long runs.
 forces=$(tr ',' '\n' <<<"$taus" | awk '{printf "%s%.10g", (NR > 1 ? "," : ""), $1 + 1}')
 scripts/sweep.sh -j "$jobs" -o "$dir" configs/fronts/oslo_front.ini \
-    block.applied_force="$forces" block.damping="$alphas" run.t_end=2000 >&2 ||
+    block.applied_force="$forces" block.damping="$alphas" run.t_end="$t_end" >&2 ||
     bk_fail 1 "the sweep failed: $dir/sweep.log says why"
 
 table=$dir/phase.tsv

@@ -430,7 +430,7 @@ static void test_front_scripts(void **state)
 
     /* The phase diagram's script on four points of the Oslo model. */
     snprintf(cmd, sizeof cmd, "BKSIM=./bksim scripts/front_phase_diagram.sh -j 2 -o %s/phase --taus 0.5,0.95 "
-             "--alphas 0.01,1 2>/dev/null", tmpdir);
+             "--alphas 0.01,1 --t-end 100 2>/dev/null", tmpdir);
     assert_int_equal(run_command(cmd, &text), 0);
     assert_non_null(strstr(text, "# tau_bar\talpha\tspeed[blocks/unit time]\treached[blocks]\tbeta\tclass\n"));
     assert_non_null(strstr(text, "0.95\t0.01\t3.2"));
