@@ -47,19 +47,8 @@ n_edge=$(awk '!/^#/' "$tmp/edge.tsv" | wc -l)
 n_blocks=$(awk '/^# fronts of/ {gsub(/[(]/, ""); for (i = 1; i <= NF; ++i) if ($(i + 1) == "blocks),") print $i}' "$tmp/fronts.tsv")
 [[ ${n_blocks:-} =~ ^[0-9]+$ ]] || n_blocks=$(awk '!/^#/ && $6 > m {m = $6} END {print m + 0}' "$tmp/edge.tsv")
 cat "$tmp/edge.tsv"
+outputs=() # the figures' paths, in the order drawn (plot_draw)
 
-partial=""
-bk_at_exit '[ -z "$partial" ] || rm -f "$partial"'
-outputs=()
-draw() { # OUT (the gnuplot script on stdin)
-    partial=$(mktemp "$outdir/.$(basename "$1").XXXXXX") || bk_fail 1 "$outdir: cannot write there"
-    { echo "set encoding utf8"; echo "set terminal $terminal"; echo "set output '$(bk_gp_quote "$partial")'"; cat; } |
-        gnuplot 2> "$tmp/gp.err" || bk_fail 1 "gnuplot failed drawing $1: $(cat "$tmp/gp.err")"
-    chmod "$(printf %o $((0666 & ~0$(umask))))" "$partial" || true
-    mv -f "$partial" "$1" || bk_fail 1 "cannot rename $partial to $1"
-    partial=""
-    outputs+=("$1")
-}
 
 # --------------------------------------------------------------- (a) precursors ---
 awk -F'\t' '!/^#/ && $3 != "nan" && $8 == 0 {print $3, $6}' "$tmp/edge.tsv" > "$tmp/arrested.dat"
@@ -73,7 +62,7 @@ series() { # FILE STYLE TITLE
 guide=""
 [ -z "$kinetic" ] || guide=", x / $kinetic with lines lw 2 dt 2 lc rgb '#555555' title 'L = F_edge / $kinetic N (at rest near the kinetic friction)'"
 out="$outdir/${stem}_precursors.$format"
-draw "$out" <<GP
+plot_draw "$out" <<GP
 set title '$(bk_gp_quote "$stem"): precursors from the $edge edge ($n_edge ruptures began there)'
 set xlabel 'edge force as the rupture began [N]'
 set ylabel 'arrest length [blocks from the edge]'
@@ -99,7 +88,7 @@ while read -r id; do
     k=$((k + 1))
 done < "$tmp/record_ids"
 out="$outdir/${stem}_fronts.$format"
-draw "$out" <<GP
+plot_draw "$out" <<GP
 set title '$(bk_gp_quote "$stem"): the fronts of the longest precursors so far (the records)'
 set xlabel 'distance from the $edge edge [blocks]'
 set ylabel 'arrival time t_onset − t_start [s]'
@@ -120,7 +109,7 @@ fi
 awk -F'\t' '!/^#/ && $6 != "nan" && $6 != "inf" {print $2, $6}' "$tmp/one.tsv" > "$tmp/speed.dat"
 mean=$(awk -F'\t' -v k="$rupture" '!/^#/ && $1 == k {print $9}' "$tmp/fronts.tsv")
 out="$outdir/${stem}_front_${rupture}_speed.$format"
-draw "$out" <<GP
+plot_draw "$out" <<GP
 set title '$(bk_gp_quote "$stem"): rupture $rupture, its front speed along the chain' . "\n" . \
           'least squares over $window blocks; mean over the rupture $mean blocks/s'
 set xlabel 'distance from the $edge edge [blocks]'

@@ -77,7 +77,8 @@ plot_file_option() {
 # plot_file_setup: after the options: FILE.h5 given (else a usage error), the format known
 # (PLOT_TERMINAL, noenhanced), FILE readable, gnuplot and bksim there.  Sets file, format,
 # terminal, bksim, outdir (default FILE's directory, created), stem (FILE's name without .h5
-# and .part) and tmp (a temporary directory, removed at exit).
+# and .part) and tmp (a temporary directory, removed at exit, as is a figure plot_draw left
+# half-drawn).
 plot_file_setup() {
     [ -n "$PLOT_FILE" ] || bk_usage "missing FILE.h5"
     file=$PLOT_FILE format=$PLOT_FORMAT
@@ -90,4 +91,19 @@ plot_file_setup() {
     mkdir -p "$outdir" || bk_fail 1 "$outdir: cannot create the output directory"
     stem=$(basename "$file"); stem=${stem%.part}; stem=${stem%.h5}
     bk_temp_dir tmp
+    PLOT_PARTIAL=""
+    bk_at_exit '[ -z "$PLOT_PARTIAL" ] || rm -f "$PLOT_PARTIAL"'
+}
+
+# plot_draw OUT: the gnuplot script on stdin (after plot_file_setup: its terminal, UTF-8)
+# drawn to OUT through a hidden file beside it, renamed when gnuplot succeeded, so that a
+# failed figure never leaves a half-written OUT; OUT is appended to the array outputs.
+plot_draw() {
+    PLOT_PARTIAL=$(mktemp "$outdir/.$(basename "$1").XXXXXX") || bk_fail 1 "$outdir: cannot write there"
+    { echo "set encoding utf8"; echo "set terminal $terminal"; echo "set output '$(bk_gp_quote "$PLOT_PARTIAL")'"; cat; } |
+        gnuplot 2> "$tmp/gp.err" || bk_fail 1 "gnuplot failed drawing $1: $(cat "$tmp/gp.err")"
+    chmod "$(printf %o $((0666 & ~0$(umask))))" "$PLOT_PARTIAL" || true
+    mv -f "$PLOT_PARTIAL" "$1" || bk_fail 1 "cannot rename $PLOT_PARTIAL to $1"
+    PLOT_PARTIAL=""
+    outputs+=("$1")
 }

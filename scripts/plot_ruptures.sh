@@ -109,19 +109,8 @@ fi
 
 # Numbers as text: a minus sign, not a hyphen.
 g() { LC_ALL=C printf "%.${2:-4}g" "$1" | sed 's/^-/−/'; }
-# Writes to a hidden file beside the figure, renamed when gnuplot succeeded.
-partial=""
-bk_at_exit '[ -z "$partial" ] || rm -f "$partial"'
+# The figures' paths, in the order drawn (plot_draw).
 outputs=()
-draw() { # OUT (the gnuplot script on stdin)
-    partial=$(mktemp "$outdir/.$(basename "$1").XXXXXX") || bk_fail 1 "$outdir: cannot write there"
-    { echo "set encoding utf8"; echo "set terminal $terminal"; echo "set output '$(bk_gp_quote "$partial")'"; cat; } |
-        gnuplot 2> "$tmp/gp.err" || bk_fail 1 "gnuplot failed drawing $1: $(cat "$tmp/gp.err")"
-    chmod "$(printf %o $((0666 & ~0$(umask))))" "$partial" || true
-    mv -f "$partial" "$1" || bk_fail 1 "cannot rename $partial to $1"
-    partial=""
-    outputs+=("$1")
-}
 
 running=""; [ "$complete" = 1 ] || running=", still running at the end of the run"
 blocks_word=blocks; [ "$r_blocks" != 1 ] || blocks_word=block
@@ -148,7 +137,7 @@ if [ "$rows" -eq 1 ]; then
     epi_plot=""
     [ ! -s "$tmp/epicentres.dat" ] ||
         epi_plot=", '$tmp/epicentres.dat' using 1:2 with points pt 7 ps 0.5 lc rgb '#000000' title 'epicentre: first_block at t_start'"
-    draw "$out" <<GP
+    plot_draw "$out" <<GP
 set title '$(bk_gp_quote "$stem"): slip of the ruptures in space and time' . "\n" . \
           '$n_in ruptures$window; each block of a rupture is a bar from its first onset to its last stop'
 set xlabel 'time t [s]'
@@ -237,7 +226,7 @@ line_plot() { # FILE TITLE COLOUR DASH
     else echo ", NaN with lines lw 2.5 dt $4 lc rgb '$3' title '$(bk_gp_quote "$2")'"; fi
 }
 pad=$(awk -v a="$x_min" -v b="$x_max" 'BEGIN {d = b - a; print (d > 0 ? 0.03 * d : 0.5)}')
-draw "$out" <<GP
+plot_draw "$out" <<GP
 set title '$(bk_gp_quote "$title_k: the front")' . "\n" . '$(bk_gp_quote "$about_k")'
 set xlabel '$(bk_gp_quote "$xlabel")'
 ${xtics_one:-}
@@ -273,7 +262,7 @@ else
     read -r n_samples integral rate_max < <(awk '
         {if (n++) s += ($1 - t) * ($2 + r) / 2; t = $1; r = $2; m = $2 > m ? $2 : m}
         END {printf "%d %.10g %.10g\n", n, s, m}' "$tmp/rate.dat")
-    draw "$out" <<GP
+    plot_draw "$out" <<GP
 set title '$(bk_gp_quote "$title_k: the moment-rate function")' . "\n" . '$(bk_gp_quote "$about_k")'
 set xlabel 'time since the rupture started, t − t_start [s]'
 set ylabel 'moment (potency) rate Σ|v| over the slipping blocks [m/s]'
@@ -385,7 +374,7 @@ left_out=""
 [ "$n_incomplete" -eq 0 ] || left_out="$n_incomplete still running at the end"
 [ "$n_zero" -eq 0 ] || left_out="${left_out:+$left_out, }$n_zero of zero potency or duration"
 ranges="by n_blocks"; [ "$by" = blocks ] || ranges="terciles of duration"
-draw "$out" <<GP
+plot_draw "$out" <<GP
 set title '$(bk_gp_quote "$stem"): moment (potency) against duration of the ruptures' . "\n" . \
           '$(bk_gp_quote "$n_md complete ruptures${left_out:+ (left out: $left_out)}; least-squares line per size range ($ranges)")' . "\n" . \
           'compare Thøgersen et al. (GRL 2019, 1D model): potency ∝ T^0.63 to T^1.5 slow, T² sub-shear, T³ supershear ruptures'
