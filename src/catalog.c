@@ -53,9 +53,12 @@ bk_catalog *bk_catalog_create_lattice(size_t rows, size_t cols, int ring_rows, i
     c->ring_rows = ring_rows;
     c->ring_cols = ring_cols;
     c->magnitude_offset = magnitude_offset;
-    c->x_onset = malloc(n_blocks * sizeof *c->x_onset);
-    c->first_force = malloc(n_blocks * sizeof *c->first_force);
-    c->last_force = malloc(n_blocks * sizeof *c->last_force);
+    /* Zeroed: a checkpoint saves last_force for every block of the open event, and a block
+     * that has not stuck yet in it has none, so its saved bytes were undefined (valgrind, on
+     * the checkpoint every run now writes at its end). */
+    c->x_onset = calloc(n_blocks, sizeof *c->x_onset);
+    c->first_force = calloc(n_blocks, sizeof *c->first_force);
+    c->last_force = calloc(n_blocks, sizeof *c->last_force);
     c->seen = malloc(n_blocks * sizeof *c->seen);
     c->slipping = calloc(n_blocks, sizeof *c->slipping);
     if (!c->x_onset || !c->first_force || !c->last_force || !c->seen || !c->slipping) {
