@@ -178,6 +178,14 @@ static inline double coupling_force(const bk_island *island, const double *y, si
     return force;
 }
 
+/* The force on block i that does not depend on velocity: its driver spring, its coupling
+ * springs and its constant applied force (bk_model_applied_force on the island's vector). */
+static inline double load_force(const bk_island *island, const double *y, size_t i, double x_i, double driver_pos)
+{
+    return driver_force(island->scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) +
+           island->scene->model->blocks[i].applied_force;
+}
+
 /* Dashpot force on block i (bk_model_damping_force on the island's vector); nothing is looked
  * up without dashpots, as the right-hand side and roots run for every scene. */
 static inline double damping_force(const bk_island *island, const double *y, size_t i)
@@ -295,7 +303,7 @@ static double balance_velocity(const bk_island *island, double t, const double *
     const double *state = block_state(island, y, i);
     double driver_pos = bk_driver_segment_position(&scene->model->driver, island->driver_segment, t);
     double x_i = position(island, y, (long)i);
-    double load = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) + b->applied_force;
+    double load = load_force(island, y, i, x_i, driver_pos);
     double eta = b->damping;
     double lo = fmin(0.0, load / eta), hi = fmax(0.0, load / eta);
     double v = guess > lo && guess < hi ? guess : 0.5 * (lo + hi);
@@ -717,8 +725,7 @@ int bk_island_roots(double t, const double *y, double *g, void *user)
         const bk_block *b = &model->blocks[i];
         double *gi = &g[R * k];
         double x_i = position(island, y, (long)i);
-        double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) +
-                         b->applied_force + damping_force(island, y, i);
+        double applied = load_force(island, y, i, x_i, driver_pos) + damping_force(island, y, i);
         const double *state = block_state(island, y, i);
         size_t s = scene->slot[i];
         if (!scene->can_stick[i]) {
@@ -756,8 +763,7 @@ double bk_island_slip_acceleration(const bk_island *island, size_t i, double t, 
     double x_i = scene->x_ref[i] + y[s], v_i = y[s + 1];
     double dir = (double)scene->mode[i];
     refresh_ghosts(island, t);
-    double applied = driver_force(scene, i, x_i, driver_pos) + coupling_force(island, y, i, x_i) +
-                     b->applied_force + damping_force(island, y, i);
+    double applied = load_force(island, y, i, x_i, driver_pos) + damping_force(island, y, i);
     double friction = b->law->sliding_force(b->friction_params, scene->normal[i], dir * v_i,
                                             block_state(island, y, i));
     if (!(b->mass > 0.0))

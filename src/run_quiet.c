@@ -26,11 +26,12 @@ static double coulomb_failure(const run_ctx *ctx, size_t i, double t, double thr
     double velocity = bk_driver_velocity(&model->driver, t);
     if (k == 0.0 || velocity == 0.0)
         return INFINITY;
-    double coupling = bk_model_coupling_force(model, i, scene->x) + model->blocks[i].applied_force;
+    /* Everything but the driver spring holds still while the neighbours do. */
+    double held = bk_model_coupling_force(model, i, scene->x) + model->blocks[i].applied_force;
     /* The driver spring force rises with D when the driver advances, falls when it retreats;
      * a tension-only spring can only pull, so a retreating driver never breaks it away
-     * unless the coupling alone does. */
-    double target_force = velocity > 0.0 ? threshold - coupling : -threshold - coupling;
+     * unless the rest alone does. */
+    double target_force = velocity > 0.0 ? threshold - held : -threshold - held;
     if (velocity < 0.0 && model->spring == BK_SPRING_TENSION_ONLY && target_force < 0.0)
         return INFINITY;
     double target_position = scene->x[i] + target_force / k;

@@ -360,10 +360,12 @@ static int show_progress(void *user, const bk_progress *r)
     return 0;
 }
 
-/* Where a run started from (--init-from): the file and the time of its end. */
+/* Where a run started from (--init-from): the file and the time of its end, said when the
+ * run starts there (not when it continues its own .part instead). */
 typedef struct start_record {
     const char *path;
     double t;
+    int quiet;
 } start_record;
 
 /* A new output at path (its .part, written from the start), marked as a sweep's point and
@@ -378,12 +380,17 @@ static int open_new_output(bk_h5_writer **writer, const bk_config *config, const
         *writer = NULL;
         opened = BK_ERR_IO;
     }
+    if (opened == BK_OK && start->path && !start->quiet)
+        fprintf(stderr, "bksim: starting from the end of %s (t = %.17g s): its blocks' positions, velocities and "
+                        "friction states and its driver's position; %s's [block] x_init, v_init and [driver] "
+                        "start_position are not used\n",
+                start->path, start->t, config->source_name);
     return opened;
 }
 
 /* --init-from: config starts where the finished run in source ended.  0, or an exit status
  * after saying why not. */
-static int start_from(bk_config *config, const char *source, int quiet, start_record *start)
+static int start_from(bk_config *config, const char *source, start_record *start)
 {
     bk_error err = {0};
     bk_checkpoint end;
@@ -394,11 +401,6 @@ static int start_from(bk_config *config, const char *source, int quiet, start_re
         if (rc == BK_OK) {
             start->path = source;
             start->t = end.t;
-            if (!quiet)
-                fprintf(stderr, "bksim: starting from the end of %s (t = %.17g s): its blocks' positions, velocities "
-                                "and friction states and its driver's position; %s's [block] x_init, v_init and "
-                                "[driver] start_position are not used\n",
-                        source, end.t, config->source_name);
         }
         bk_checkpoint_free(&end);
         bk_config_free(from);
@@ -442,8 +444,8 @@ static int cmd_run(int argc, char **argv)
     const char *path = args.output ? args.output : config ? config->output.path : NULL;
     char *restart_path = NULL;
     int opened;
-    start_record start = {NULL, 0.0};
-    if (args.init_from && (status = start_from(config, args.init_from, args.quiet, &start)) != 0) {
+    start_record start = {NULL, 0.0, args.quiet};
+    if (args.init_from && (status = start_from(config, args.init_from, &start)) != 0) {
         bk_config_free(config);
         free(args.overrides);
         return status;

@@ -28,45 +28,21 @@ static char *with_t_end(const char *overrides, double t_end)
     return text;
 }
 
-/* Load the config stored in file with the later t_end, to check it (a driver history may be
- * shorter than t_end, say); its old t_end into *old_t_end. */
-static int check_longer(hid_t file, const char *path, const char *overrides, double t_end, double *old_t_end,
-                        bk_error *err)
+/* The run's own t_end (root attribute t_end) into *old_t_end, and the stored config loaded
+ * with the later one, to check it (a driver history may be shorter than t_end, say). */
+static int check_longer(hid_t file, const char *path, double t_end, double *old_t_end, bk_error *err)
 {
-    bk_config *config = NULL;
-    int rc = bk_h5_load_stored_config(file, path, &config, err);
-    if (rc != BK_OK)
-        return rc;
-    *old_t_end = config->t_end;
-    bk_config_free(config);
+    if (bk_h5_read_numeric_attr(file, "t_end", H5T_NATIVE_DOUBLE, old_t_end) < 0)
+        return BK_FAIL(err, BK_ERR_DAMAGED, "%s: damaged: no root attribute t_end", path);
     if (!(t_end > *old_t_end))
         return BK_FAIL(err, BK_ERR_INVALID,
                        "%s: --set run.t_end=%.17g: a restart may only make the run longer than its t_end = %.17g s",
                        path, t_end, *old_t_end);
-    char *text = bk_h5_read_string_attr(file, "config_file");
-    char *name = bk_h5_read_string_attr(file, "config_name");
-    char *all = with_t_end(overrides, t_end);
-    const char **list = NULL;
-    size_t n = 0;
-    for (const char *p = all; p && *p; p = strchr(p, '\n') + 1)
-        ++n;
-    list = calloc(n + 1, sizeof *list);
-    if (!text || !name || !all || !list) {
-        rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
-    } else {
-        size_t k = 0;
-        for (char *p = all; *p; ++p) {
-            list[k++] = p;
-            p = strchr(p, '\n');
-            *p = '\0';
-        }
-        rc = bk_config_load_string(text, name, list, n, &config, err);
-        bk_config_free(config);
-    }
-    free(list);
-    free(all);
-    free(text);
-    free(name);
+    char setting[64];
+    snprintf(setting, sizeof setting, "run.t_end=%.17g", t_end);
+    bk_config *config = NULL;
+    int rc = bk_h5_load_stored_config_with(file, path, setting, &config, err);
+    bk_config_free(config);
     return rc;
 }
 
@@ -109,7 +85,7 @@ int bk_h5_extend_to(const char *path, double t_end, double *old_t_end, bk_error 
     }
     if (rc == BK_OK) {
         overrides = bk_h5_read_string_attr(file, "overrides");
-        rc = check_longer(file, file_path, overrides, t_end, old_t_end, err);
+        rc = check_longer(file, file_path, t_end, old_t_end, err);
     }
     bk_h5_close_id(file);
     /* The finished file becomes a .part before it is changed: a kill in between leaves a .part

@@ -236,6 +236,9 @@ char *bk_h5_recorded_datasets(hid_t file);
 int bk_h5_require_datasets(hid_t file, const char *path, const char *names, bk_error *err);
 /* The config a run stored (file text and --set overrides, any number of them). */
 int bk_h5_load_stored_config(hid_t file, const char *path, bk_config **config, bk_error *err);
+/* The same with one more --set override after the stored ones (NULL: none). */
+int bk_h5_load_stored_config_with(hid_t file, const char *path, const char *extra, bk_config **config,
+                                  bk_error *err);
 
 /* --------------------------------------------------------------- checkpoints --- */
 

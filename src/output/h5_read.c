@@ -395,8 +395,15 @@ int bk_h5_read_config(const char *path, bk_config **config, bk_error *err)
     return rc;
 }
 
-/* The config a run stored (file text and --set overrides, any number of them). */
 int bk_h5_load_stored_config(hid_t file, const char *path, bk_config **config, bk_error *err)
+{
+    return bk_h5_load_stored_config_with(file, path, NULL, config, err);
+}
+
+/* The config a run stored (file text and --set overrides, any number of them), and extra
+ * after them when given. */
+int bk_h5_load_stored_config_with(hid_t file, const char *path, const char *extra, bk_config **config,
+                                  bk_error *err)
 {
     *config = NULL;
     char *text = bk_h5_read_string_attr(file, "config_file");
@@ -417,6 +424,15 @@ int bk_h5_load_stored_config(hid_t file, const char *path, bk_config **config, b
         }
         list = grown;
         list[n_over++] = line;
+    }
+    if (rc == BK_OK && extra) {
+        const char **grown = bk_grow_array(list, &cap, n_over + 1, sizeof *grown, 16);
+        if (grown) {
+            list = grown;
+            list[n_over++] = extra;
+        } else {
+            rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for the stored overrides", path);
+        }
     }
     if (rc == BK_OK)
         rc = bk_config_load_string(text, name, list, n_over, config, err);
