@@ -36,6 +36,23 @@ char *bk_output_part_path(const char *path)
     return part;
 }
 
+char *bk_output_resolve(const char *path, const char *config_name)
+{
+    size_t len = strlen(path);
+    struct stat st;
+    int directory = (len > 0 && path[len - 1] == '/') || (stat(path, &st) == 0 && S_ISDIR(st.st_mode));
+    if (!directory)
+        return strdup(path);
+    const char *base = config_name ? strrchr(config_name, '/') : NULL;
+    base = base ? base + 1 : config_name && *config_name ? config_name : "bksim";
+    const char *dot = strrchr(base, '.');
+    size_t stem = dot && dot != base ? (size_t)(dot - base) : strlen(base);
+    char *resolved = malloc(len + stem + sizeof "/.h5");
+    if (resolved)
+        sprintf(resolved, "%s%s%.*s.h5", path, len > 0 && path[len - 1] == '/' ? "" : "/", (int)stem, base);
+    return resolved;
+}
+
 /* mkdir -p for the directory part of path. */
 int bk_output_make_parent_dirs(const char *path, bk_error *err)
 {

@@ -60,8 +60,7 @@ static double sample_time(const run_ctx *ctx, long k)
  * same scene goes on (--restart with a later t_end). */
 static int ends_with_checkpoint(const run_ctx *ctx)
 {
-    return ctx->sink && ctx->sink->checkpoint &&
-           (ctx->checkpoint_interval > 0.0 || ctx->checkpoint_work > 0.0);
+    return bk_run_has_restart_points(ctx);
 }
 
 /* The sample a run continued past t_end emits first: the first on the grid after t_end (a

@@ -26,8 +26,23 @@ int bk_run_report_progress(run_ctx *ctx, double t)
             .events = ctx->catalog ? ctx->events : -1,
             .events_resumed = ctx->events_resumed,
         };
-        if (ctx->progress(ctx->progress_user, &report) != 0)
+        int asked = ctx->progress(ctx->progress_user, &report);
+        if (asked == BK_PROGRESS_CHECKPOINT_AND_STOP && bk_run_has_restart_points(ctx)) {
+            /* Another restart point than the run's own would change the run: go on to the
+             * next one (bk_run_restart_all stops there), within the grace time. */
+            double now = bk_run_wall_seconds();
+            if (!ctx->stop_at_restart) {
+                ctx->stop_at_restart = 1;
+                ctx->wall_stop_asked = now;
+            } else if (now - ctx->wall_stop_asked > BK_STOP_GRACE) {
+                return BK_FAIL(ctx->err, BK_ERR_INTERRUPTED,
+                               "run interrupted at t = %.17g s: its next restart point was not reached within "
+                               "%g s of the request to stop, so none was written (the last checkpoint stays)",
+                               t, BK_STOP_GRACE);
+            }
+        } else if (asked != 0) {
             return BK_FAIL(ctx->err, BK_ERR_INTERRUPTED, "run interrupted at t = %.17g s", t);
+        }
     }
     double limit = ctx->config->wall_time_limit;
     if (limit > 0.0 && bk_run_wall_seconds() - ctx->wall_start > limit)

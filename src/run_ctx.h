@@ -134,6 +134,8 @@ typedef struct run_ctx {
     double t_settled;                /* s, the time of the scheduler's last action */
     double checkpoint_wall_interval; /* s: write a restart point once this has passed */
     double wall_checkpoint;          /* s, monotonic clock at the last one written (or the start) */
+    int stop_at_restart;             /* the progress callback asked to stop at the next one */
+    double wall_stop_asked;          /* s, monotonic clock when it asked */
     bk_run_stats base;    /* counters of the run this one resumed, if any */
 
     /* The event catalog (run_catalog.c); NULL when the run keeps none. */
@@ -164,6 +166,13 @@ typedef struct run_ctx {
 } run_ctx;
 
 /* qsort's order of block indices (size_t). */
+/* Whether the run has restart points: a checkpoint interval, or work between them, and a
+ * sink that keeps checkpoints. */
+static inline int bk_run_has_restart_points(const run_ctx *ctx)
+{
+    return ctx->sink && ctx->sink->checkpoint && (ctx->checkpoint_interval > 0.0 || ctx->checkpoint_work > 0.0);
+}
+
 static inline int bk_compare_blocks(const void *a, const void *b)
 {
     size_t x = *(const size_t *)a, y = *(const size_t *)b;

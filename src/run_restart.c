@@ -34,10 +34,16 @@ int bk_run_restart_all(run_ctx *ctx, double t, int restart_point)
     ctx->restart_work = 0.0;
     ctx->t_restart = INFINITY;
     double now = bk_run_wall_seconds();
-    if (ctx->sink && ctx->sink->checkpoint && now - ctx->wall_checkpoint >= ctx->checkpoint_wall_interval) {
+    if (ctx->sink && ctx->sink->checkpoint &&
+        (ctx->stop_at_restart || now - ctx->wall_checkpoint >= ctx->checkpoint_wall_interval)) {
         ctx->wall_checkpoint = now;
         if ((rc = bk_run_write_checkpoint(ctx, t, ctx->next_sample)) != BK_OK)
             return rc;
+        if (ctx->stop_at_restart)
+            return BK_FAIL(ctx->err, BK_ERR_INTERRUPTED,
+                           "run interrupted at t = %.17g s, its restart point, written as a checkpoint "
+                           "%.2g s after the request to stop",
+                           t, now - ctx->wall_stop_asked);
     }
     /* A checkpoint is a restart of everything, as a resumed run starts. */
     return bk_run_partition_all(ctx, t);

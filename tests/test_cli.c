@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include <hdf5.h>
 
@@ -453,6 +454,91 @@ static void test_damaged_files(void **state)
     assert_non_null(strstr(err.message, "/v has 100 rows"));
 }
 
+/* The file at path still holds exactly text. */
+static void assert_file_holds(const char *path, const char *text)
+{
+    char *held = file_contents(path);
+    assert_non_null(held);
+    assert_string_equal(held, text);
+    free(held);
+}
+
+/* `-o` never turns a file that is not bksim's into HDF5, whatever the flags: the run's own
+ * config, a text file, a foreign .part; a bksim output is replaced as before.  `-o DIR/` and
+ * `-o DIR` (an existing directory) write DIR/<config stem>.h5. */
+static void test_never_replaces_others_files(void **state)
+{
+    (void)state;
+    char cmd[4096], config[512], notes[512], out[512];
+    snprintf(config, sizeof config, "%s/c.ini", tmpdir);
+    snprintf(cmd, sizeof cmd, "cp configs/paper/case_a_coulomb.ini %s", config);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    char *config_text = file_contents(config);
+    assert_non_null(config_text);
+
+    for (int force = 0; force < 2; ++force) {
+        snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --quiet%s", config, config, force ? " --force" : "");
+        expect_command(cmd, 2, "c.ini: exists and is not a bksim output (not an HDF5 file): bksim replaces only "
+                               "its own outputs, whatever the flags");
+        assert_file_holds(config, config_text);
+        snprintf(notes, sizeof notes, "%s/notes.txt", tmpdir);
+        assert_int_equal(write_text(notes, "my notes\n"), 0);
+        snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --quiet%s", config, notes, force ? " --force" : "");
+        expect_command(cmd, 2, "notes.txt: exists and is not a bksim output");
+        assert_file_holds(notes, "my notes\n");
+    }
+    char part[600];
+    snprintf(out, sizeof out, "%s/o.h5", tmpdir);
+    snprintf(part, sizeof part, "%s.part", out);
+    assert_int_equal(write_text(part, "not a run\n"), 0);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --quiet --force", config, out);
+    expect_command(cmd, 2, "o.h5.part: exists and is not a bksim output");
+    assert_file_holds(part, "not a run\n");
+    assert_false(path_exists(out));
+    remove(part);
+
+    /* bksim's own output: replaced on a rerun, with or without --force. */
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --quiet && ./bksim run %s -o %s --quiet --force "
+                              "&& ./bksim run %s -o %s --quiet", config, out, config, out, config, out);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    assert_false(path_exists(part));
+
+    /* A .part to continue (a finished run's, with its end checkpoint) whose final name a
+     * file of the user's took meanwhile: --restart and --resume refuse before running. */
+    char other[600], other_part[700];
+    snprintf(other, sizeof other, "%s/other.h5", tmpdir);
+    snprintf(other_part, sizeof other_part, "%s.part", other);
+    snprintf(cmd, sizeof cmd, "cp %s %s", out, other_part);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    assert_int_equal(write_text(other, "results of another program\n"), 0);
+    snprintf(cmd, sizeof cmd, "./bksim run --restart %s", other_part);
+    expect_command(cmd, 2, "other.h5: exists and is not a bksim output");
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --resume", config, other);
+    expect_command(cmd, 2, "other.h5: exists and is not a bksim output");
+    assert_file_holds(other, "results of another program\n");
+    assert_true(path_exists(other_part));
+
+    /* Directories. */
+    char dir[600], expected[700];
+    snprintf(dir, sizeof dir, "%s/new/", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --quiet", config, dir);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    snprintf(expected, sizeof expected, "%sc.h5", dir);
+    assert_true(path_exists(expected));
+    snprintf(expected, sizeof expected, "%s.part", dir);
+    assert_false(path_exists(expected));
+    remove_tree(dir);
+    snprintf(dir, sizeof dir, "%s/existing", tmpdir);
+    assert_int_equal(mkdir(dir, 0700), 0);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s", config, dir);
+    expect_command(cmd, 0, "existing/c.h5: ");
+    snprintf(expected, sizeof expected, "%s/c.h5", dir);
+    bk_error err = {0};
+    assert_int_equal(bk_h5_verify(expected, &err), BK_OK);
+    remove_tree(dir);
+    free(config_text);
+}
+
 /* README's config reference is exactly what `bksim keys` prints. */
 static void test_readme_reference_current(void **state)
 {
@@ -489,6 +575,7 @@ int main(void)
         cmocka_unit_test(test_progress_on_terminal),
         cmocka_unit_test(test_info_at_chain_scale),
         cmocka_unit_test(test_damaged_files),
+        cmocka_unit_test(test_never_replaces_others_files),
         cmocka_unit_test(test_readme_reference_current),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);

@@ -337,6 +337,67 @@ static double seconds_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* SIGTERM (what SLURM sends KillWait before its SIGKILL) at random moments: the run goes on to
+ * its next restart point, writes it as a checkpoint and stops there, well within the grace
+ * time; --restart then ends with the very output of an uninterrupted run.  Restart points
+ * every 2e4 units of work (some 45 in the run), no wall-clock checkpoints (300 s never
+ * passes): only the request makes one. */
+static void test_sigterm_keeps_the_work(void **state)
+{
+    (void)state;
+    const char *scene = "configs/chains/bk10_coulomb.ini --quiet --set run.t_end=20 --set output.checkpoint_work=2e4";
+    char reference[512], out[512], cmd[2048], *text = NULL;
+    snprintf(reference, sizeof reference, "%s/term_reference.h5", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s", scene, reference);
+    double t0 = seconds_now();
+    assert_int_equal(run_command(cmd, NULL), 0);
+    double wall = seconds_now() - t0;
+    unsigned long long lcg = 20261128; /* fixed: the same signal times on every run of the test */
+    int stopped = 0;
+    for (int k = 0; k < 8 && stopped < 3; ++k) {
+        lcg = lcg * 6364136223846793005ull + 1442695040888963407ull;
+        double u = (double)(lcg >> 11) / 9007199254740992.0;
+        snprintf(out, sizeof out, "%s/term_%d.h5", tmpdir, k);
+        /* The time from the signal to the exit, in ns, after the exit status. */
+        snprintf(cmd, sizeof cmd, "./bksim run %s -o %s & pid=$!; sleep %.3f; s=$(date +%%s%%N); kill -TERM $pid; "
+                 "wait $pid; rc=$?; echo \"exit $rc after $(( $(date +%%s%%N) - s ))\"", scene, out, wall * (0.1 + 0.7 * u));
+        assert_int_equal(run_command(cmd, &text), 0);
+        const char *said = strstr(text, "exit ");
+        assert_non_null(said);
+        int status = -1;
+        long long ns = -1;
+        assert_int_equal(sscanf(said, "exit %d after %lld", &status, &ns), 2);
+        if (status == 0) { /* the run was done before the signal came */
+            free(text);
+            continue;
+        }
+        assert_int_equal(status, 1);
+        assert_non_null(strstr(text, "its restart point, written as a checkpoint"));
+        assert_non_null(strstr(text, "continue it from its checkpoint t = "));
+        print_message("SIGTERM %.3f s in: stopped %.3f s later at its next restart point\n", wall * (0.1 + 0.7 * u),
+                      (double)ns * 1e-9);
+        assert_true((double)ns * 1e-9 < BK_STOP_GRACE);
+        free(text);
+        snprintf(cmd, sizeof cmd, "./bksim info %s.part", out);
+        expect_command(cmd, 3, "continues from it");
+        snprintf(cmd, sizeof cmd, "./bksim run --restart %s.part --quiet", out);
+        assert_int_equal(run_command(cmd, NULL), 0);
+        assert_same_output(reference, out);
+        ++stopped;
+    }
+    assert_int_equal(stopped, 3);
+
+    /* Without restart points ([output] checkpoint_interval = 0) it stops at once, and says
+     * that the .part cannot be continued. */
+    snprintf(out, sizeof out, "%s/term_none.h5", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run configs/paper/case_c_coulomb.ini -o %s --quiet --set run.t_end=100000 "
+             "--set output.interval=1e-3 --set output.checkpoint_interval=0 & pid=$!; sleep 0.5; kill -TERM $pid; "
+             "wait $pid", out);
+    assert_int_equal(run_command(cmd, &text), 1);
+    assert_non_null(strstr(text, "it holds no checkpoint, so it cannot be continued"));
+    free(text);
+}
+
 /* A run with the default checkpoint settings, scaled down (restart points every 2e4 units of
  * work instead of 1e7, some 45 in the run; the wall-clock interval a quarter of the run),
  * writes a checkpoint once that interval has passed; killed then and restarted, it ends with
@@ -540,6 +601,7 @@ int main(void)
         cmocka_unit_test(test_restart_equivalence),
         cmocka_unit_test(test_sigkill_restart_loop),
         cmocka_unit_test(test_wall_clock_checkpoint),
+        cmocka_unit_test(test_sigterm_keeps_the_work),
         cmocka_unit_test(test_restart_errors),
         cmocka_unit_test(test_resume_sets_damaged_aside),
     };

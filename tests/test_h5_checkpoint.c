@@ -225,9 +225,14 @@ static void test_restartable(void **state)
     assert_int_equal(bk_h5_restartable(f->path, &t, &err), 0);
     assert_true(t == -1.0);
 
-    /* Garbage under the .part name. */
+    /* Garbage under the .part name: nothing to restart, and not bksim's to replace. */
     assert_int_equal(write_text(part_path(f->path), "not HDF5\n"), 0);
     assert_int_equal(bk_h5_restartable(f->path, &t, &err), 0);
+    bk_h5_writer *refused = NULL;
+    assert_int_equal(bk_h5_writer_open(&refused, config, f->path, &err), BK_ERR_INVALID);
+    assert_non_null(strstr(err.message, ".part: exists and is not a bksim output (not an HDF5 file)"));
+    /* Empty (a run killed as it created it): bksim's working file, replaced. */
+    assert_int_equal(write_text(part_path(f->path), ""), 0);
 
     run_into(config, f->path, 2, 10);
     assert_int_equal(bk_h5_restartable(f->path, NULL, &err), 1);

@@ -542,31 +542,80 @@ static void test_write_failure_in_finish(void **state)
     run_out_of_space(f->path, FAIL_IN_FINISH);
 }
 
-/* rename() fails (a directory took the name meanwhile): finish reports it, and the .part,
- * already marked complete, is marked incomplete again with the reason. */
-static void test_rename_failure(void **state)
+/* Something took the final name while the run wrote (a directory, a file of the user's):
+ * finish refuses to replace it, leaves it as it was, and the .part, already marked complete,
+ * is marked incomplete again with the reason. */
+static void finish_refused(const char *path, const bk_config *c, const char *reason)
+{
+    bk_h5_writer *w;
+    bk_error err;
+    assert_int_equal(bk_h5_writer_open(&w, c, path, &err), BK_OK);
+    bk_sink sink = bk_h5_writer_sink(w);
+    write_rows(&sink, c, 10);
+    if (reason[0] == 'd') {
+        assert_int_equal(mkdir(path, 0700), 0);
+        char inside[256];
+        snprintf(inside, sizeof inside, "%s/keep", path);
+        assert_int_equal(write_text(inside, ""), 0);
+    } else {
+        assert_int_equal(write_text(path, "the user's notes\n"), 0);
+    }
+    assert_int_equal(bk_h5_writer_finish(w, NULL, &err), BK_ERR_INVALID);
+    const char *said = reason[0] == 'd' ? "is a directory" : "exists and is not a bksim output (not an HDF5 file)";
+    assert_non_null(strstr(err.message, said));
+    hid_t file = H5Fopen(part_path(path), H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(file >= 0);
+    assert_int_equal(attr_llong(file, "complete"), 0);
+    char *s = attr_string(file, "error");
+    assert_non_null(strstr(s, said));
+    free(s);
+    H5Fclose(file);
+    check_series(part_path(path), "x", 10, 2, W_X);
+    if (reason[0] != 'd') {
+        char *text = file_contents(path);
+        assert_non_null(text);
+        assert_string_equal(text, "the user's notes\n");
+        free(text);
+    }
+}
+
+static void test_name_taken_meanwhile(void **state)
+{
+    output_fixture *f = *state;
+    bk_config *c = synthetic_config(2, BK_FIELD_X, 0, 0);
+    finish_refused(f->path, c, "directory");
+    char other[512];
+    snprintf(other, sizeof other, "%s.notes", f->path);
+    finish_refused(other, c, "file");
+    remove(other);
+    remove(part_path(other));
+    bk_config_free(c);
+}
+
+/* Opening never truncates a file that is not bksim's, at OUT or at OUT.part, and says what
+ * is there; an HDF5 file of another program is not bksim's either. */
+static void test_open_refuses_others_files(void **state)
 {
     output_fixture *f = *state;
     bk_config *c = synthetic_config(2, BK_FIELD_X, 0, 0);
     bk_h5_writer *w;
     bk_error err;
-    assert_int_equal(bk_h5_writer_open(&w, c, f->path, &err), BK_OK);
-    bk_sink sink = bk_h5_writer_sink(w);
-    write_rows(&sink, c, 10);
-    assert_int_equal(mkdir(f->path, 0700), 0);
-    char inside[256];
-    snprintf(inside, sizeof inside, "%s/keep", f->path);
-    assert_int_equal(write_text(inside, ""), 0);
-    assert_int_equal(bk_h5_writer_finish(w, NULL, &err), BK_ERR_IO);
-    assert_non_null(strstr(err.message, "cannot rename to"));
-    hid_t file = H5Fopen(part_path(f->path), H5F_ACC_RDONLY, H5P_DEFAULT);
-    assert_true(file >= 0);
-    assert_int_equal(attr_llong(file, "complete"), 0);
-    char *s = attr_string(file, "error");
-    assert_non_null(strstr(s, "cannot rename to"));
-    free(s);
-    H5Fclose(file);
-    check_series(part_path(f->path), "x", 10, 2, W_X);
+    assert_int_equal(write_text(f->path, "a config, say\n"), 0);
+    assert_int_equal(bk_h5_writer_open(&w, c, f->path, &err), BK_ERR_INVALID);
+    assert_non_null(strstr(err.message, "exists and is not a bksim output (not an HDF5 file)"));
+    assert_false(path_exists(part_path(f->path)));
+    remove(f->path);
+    assert_int_equal(write_text(part_path(f->path), "notes\n"), 0);
+    assert_int_equal(bk_h5_writer_open(&w, c, f->path, &err), BK_ERR_INVALID);
+    assert_non_null(strstr(err.message, ".part: exists and is not a bksim output"));
+    remove(part_path(f->path));
+    hid_t other = H5Fcreate(f->path, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    assert_true(other >= 0);
+    H5Fclose(other);
+    assert_int_equal(bk_h5_writer_open(&w, c, f->path, &err), BK_ERR_INVALID);
+    assert_non_null(strstr(err.message, "an HDF5 file without bksim's root attributes"));
+    remove(f->path);
+    /* A bksim output is replaced (test_finish_replaces_old_output). */
     bk_config_free(c);
 }
 
@@ -598,17 +647,18 @@ static void test_open_fails_cleanly(void **state)
     assert_non_null(strstr(err.message, blocker));
     assert_non_null(strstr(err.message, "not a directory"));
 
-    /* The output path names an existing directory. */
-    assert_int_equal(bk_h5_writer_open(&w, c, f->dir, &err), BK_ERR_IO);
+    /* The output path names an existing directory (the CLI puts its file in it instead:
+     * bk_output_resolve). */
+    assert_int_equal(bk_h5_writer_open(&w, c, f->dir, &err), BK_ERR_INVALID);
     assert_non_null(strstr(err.message, "is a directory"));
 
-    /* Creation itself fails (the .part name is taken by a directory): nothing is left. */
+    /* The .part name is taken by a directory: refused before anything is created. */
     char part[320];
     snprintf(path, sizeof path, "%s/taken.h5", f->dir);
     snprintf(part, sizeof part, "%s.part", path);
     assert_int_equal(mkdir(part, 0700), 0);
-    assert_int_equal(bk_h5_writer_open(&w, c, path, &err), BK_ERR_HDF5);
-    assert_non_null(strstr(err.message, "cannot create file"));
+    assert_int_equal(bk_h5_writer_open(&w, c, path, &err), BK_ERR_INVALID);
+    assert_non_null(strstr(err.message, ".part: is a directory"));
     assert_false(path_exists(path));
     bk_config_free(c);
 }
@@ -684,7 +734,8 @@ int main(int argc, char **argv)
         OUTPUT_TEST(test_write_failure_finish),
         OUTPUT_TEST(test_write_failure_abandon),
         OUTPUT_TEST(test_write_failure_in_finish),
-        OUTPUT_TEST(test_rename_failure),
+        OUTPUT_TEST(test_name_taken_meanwhile),
+        OUTPUT_TEST(test_open_refuses_others_files),
         OUTPUT_TEST(test_open_creates_directories),
         OUTPUT_TEST(test_open_fails_cleanly),
     };

@@ -71,6 +71,14 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
  * refusing to overwrite restartable work. */
 int bk_h5_restartable(const char *path, double *t_checkpoint, bk_error *err);
 
+/* Whether a run may write over path: BK_OK when nothing is there or it is a bksim output
+ * (an HDF5 file with bksim's root attributes config, version and n_blocks), or, for a
+ * working file (working = 1: a .part), an empty file or one with HDF5's signature (a run
+ * killed while creating it); else BK_ERR_INVALID naming what is there (a file of the user's,
+ * a directory, a device).  The writer asks it for OUT and OUT.part when it opens and again
+ * before the rename that publishes OUT, so no flag ever replaces a file that is not bksim's. */
+int bk_h5_output_replaceable(const char *path, int working, bk_error *err);
+
 /* Make the run in path (finished: OUT, or stopped: OUT.part) longer, to t_end: checked
  * (later than its own t_end, which goes to *old_t_end; the stored config loads with it; a
  * checkpoint to continue from), stored as one more --set override, and a finished OUT
@@ -90,6 +98,11 @@ int bk_h5_read_end_state(const char *path, bk_checkpoint *end, bk_config **confi
 int bk_output_is_part(const char *path);
 char *bk_output_part_path(const char *path);
 char *bk_output_final_path(const char *path);
+/* An output path that names a directory (it ends in '/' or is one) means the file
+ * "<dir>/<stem>.h5" in it, stem being config_name's base name without its extension (c.ini
+ * -> c.h5), as `cp file dir/` does; any other path is itself.  Malloc'ed; NULL when out of
+ * memory. */
+char *bk_output_resolve(const char *path, const char *config_name);
 /* Move a .part that cannot be continued out of the way, to "<part>.damaged" (or
  * "<part>.damaged.2", ... when that exists), so that starting over does not destroy it;
  * *kept (malloc'd) gets the new name. */

@@ -112,7 +112,15 @@ typedef struct bk_progress {
     long events_resumed; /* events completed before t_resumed */
 } bk_progress;
 
-/* Called now and then; return non-zero to stop the run. */
+/* Called now and then; return 0 to go on, BK_PROGRESS_STOP to stop the run at once, or
+ * BK_PROGRESS_CHECKPOINT_AND_STOP to stop at its next restart point, written as a checkpoint
+ * whatever the wall clock says, so that a restart continues exactly as if the run had never
+ * stopped (what a batch system's SIGTERM asks for).  A run without restart points, or one
+ * that has not reached its next within BK_STOP_GRACE seconds of wall-clock time after the
+ * request, stops at once; either stop returns BK_ERR_INTERRUPTED. */
+#define BK_PROGRESS_STOP 1
+#define BK_PROGRESS_CHECKPOINT_AND_STOP 2
+#define BK_STOP_GRACE 20.0
 typedef int (*bk_progress_fn)(void *user, const bk_progress *progress);
 
 #endif

@@ -66,7 +66,9 @@ static const char *const run_help =
     "                     --set run.t_end=T (the one --set it takes) a finished or stopped\n"
     "                     run goes on to a later T: OUT becomes OUT.part again, continued\n"
     "                     from its last checkpoint (a finished run's is at its end)\n"
-    "  -o, --output OUT   output path (overrides [output] path)\n"
+    "  -o, --output OUT   output path (overrides [output] path); OUT ending in / or an\n"
+    "                     existing directory means OUT/<config name>.h5.  Only a bksim\n"
+    "                     output is ever replaced: any other file there is refused\n"
     "  --set S.K=V        override key K of section S after reading CONFIG; S may be\n"
     "                     block.3 or friction.3 for one block (repeatable)\n"
     "  -q, --quiet        no progress indicator and no summary\n"
@@ -84,7 +86,10 @@ static const char *const run_help =
     "  --strict           refuse (exit 2) a config that draws a warning: a value far outside\n"
     "                     what the others make plausible (see `bksim check --help`)\n"
     "The file is written as OUT.part and renamed to OUT when the run completes; a failed\n"
-    "or interrupted run leaves OUT.part marked complete = 0.\n";
+    "or interrupted run leaves OUT.part marked complete = 0.\n"
+    "A first SIGTERM, SIGINT or SIGHUP stops the run at its next restart point, written as\n"
+    "a checkpoint for --restart (at once when there is none within 20 s); a second stops it\n"
+    "at once.\n";
 
 static const char *const check_help =
     "usage: bksim check CONFIG [--set section.key=value]... [--strict]\n"
@@ -131,8 +136,10 @@ static void on_signal(int signo)
 }
 
 /* The first SIGINT, SIGTERM, SIGHUP (terminal gone) or SIGXCPU (a batch system's CPU limit)
- * asks the run to stop at the next step or row and leave a valid, incomplete file; a second
- * SIGINT, SIGTERM or SIGHUP (any of them) then stops the process at once. */
+ * asks the run to stop at its next restart point, written as a checkpoint (within
+ * BK_STOP_GRACE s, else at once; at once without restart points), and leave a valid,
+ * incomplete file that --restart continues; a second SIGINT, SIGTERM or SIGHUP (any of
+ * them) then stops the process at once. */
 static void catch_stop_signals(void)
 {
     struct sigaction action;
@@ -329,8 +336,10 @@ static void format_duration(char *out, size_t size, double seconds)
 static int show_progress(void *user, const bk_progress *r)
 {
     progress_state *p = user;
+    /* SLURM's SIGTERM comes KillWait (30 s by default) before its SIGKILL: on to the next
+     * restart point, which is written, so that nothing computed is lost. */
     if (stop_requested)
-        return 1;
+        return BK_PROGRESS_CHECKPOINT_AND_STOP;
     if (!p->enabled)
         return 0;
     double now = now_seconds();
@@ -441,12 +450,22 @@ static int cmd_run(int argc, char **argv)
     bk_h5_writer *writer = NULL;
     bk_checkpoint checkpoint;
     memset(&checkpoint, 0, sizeof checkpoint);
-    const char *path = args.output ? args.output : config ? config->output.path : NULL;
+    /* -o DIR/ (or an existing directory) puts the output in it, named after the config. */
+    char *resolved_path = NULL;
+    const char *given_path = args.output ? args.output : config ? config->output.path : NULL;
+    if (given_path && !args.restart && !(resolved_path = bk_output_resolve(given_path, config ? config->source_name : NULL))) {
+        fprintf(stderr, "bksim: out of memory\n");
+        bk_config_free(config);
+        free(args.overrides);
+        return EXIT_RUN_FAILED;
+    }
+    const char *path = resolved_path ? resolved_path : given_path;
     char *restart_path = NULL;
     int opened;
     start_record start = {NULL, 0.0, args.quiet};
     if (args.init_from && (status = start_from(config, args.init_from, &start)) != 0) {
         bk_config_free(config);
+        free(resolved_path);
         free(args.overrides);
         return status;
     }
@@ -463,6 +482,7 @@ static int cmd_run(int argc, char **argv)
         if (restartable < 0) {
             fprintf(stderr, "%s\n", err.message);
             bk_config_free(config);
+            free(resolved_path);
             free(args.overrides);
             return EXIT_RUN_FAILED;
         }
@@ -518,17 +538,21 @@ static int cmd_run(int argc, char **argv)
                     "`bksim run --restart %s.part`, or pass --force to start over\n",
                     path, t_checkpoint, path);
             bk_config_free(config);
+            free(resolved_path);
             free(args.overrides);
             return EXIT_USAGE;
         } else {
             /* Never silently: a stopped run's .part without a checkpoint is replaced. */
             char *part = bk_output_part_path(path);
             struct stat st;
-            if (part && stat(part, &st) == 0 && !args.quiet)
+            int replaced = part && stat(part, &st) == 0;
+            opened = open_new_output(&writer, config, path, args.point, &start, &err);
+            /* Said once it is true: a .part another run writes, or a file not bksim's, is
+             * refused instead. */
+            if (replaced && opened == BK_OK && !args.quiet)
                 fprintf(stderr, "bksim: starting over: %s is replaced (%s)\n", part,
                         args.force ? "--force" : "it holds no checkpoint to continue from");
             free(part);
-            opened = open_new_output(&writer, config, path, args.point, &start, &err);
         }
     }
     if (opened != BK_OK) {
@@ -536,6 +560,7 @@ static int cmd_run(int argc, char **argv)
         bk_config_free(config);
         free(args.overrides);
         free(restart_path);
+        free(resolved_path);
         return opened == BK_ERR_INVALID || opened == BK_ERR_CONFIG ? EXIT_USAGE : EXIT_RUN_FAILED;
     }
     catch_stop_signals();
@@ -582,6 +607,7 @@ static int cmd_run(int argc, char **argv)
     bk_config_free(config);
     free(args.overrides);
     free(restart_path);
+    free(resolved_path);
     return status;
 }
 

@@ -70,6 +70,11 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
     if (rc != BK_OK)
         return rc;
     struct stat st;
+    /* The continued run ends by renaming onto the final name: never over a file not ours. */
+    if (stat(w->part, &st) == 0 && (rc = bk_h5_output_replaceable(w->path, 0, err)) != BK_OK) {
+        bk_h5_writer_free(w);
+        return rc;
+    }
     if (stat(w->part, &st) != 0) {
         int complete = 0;
         hid_t done = stat(w->path, &st) == 0 ? H5Fopen(w->path, H5F_ACC_RDONLY, H5P_DEFAULT) : H5I_INVALID_HID;

@@ -349,17 +349,16 @@ int bk_h5_writer_open(bk_h5_writer **out, const bk_config *config, const char *p
         return BK_FAIL(err, BK_ERR_INVALID,
                        "bk_h5_writer_open: needs a writer pointer, a config with a model and "
                        "an output path");
-    struct stat st;
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
-        return BK_FAIL(err, BK_ERR_IO, "%s: is a directory; give an output file name", path);
-
     bk_h5_writer *w;
     int rc = bk_h5_writer_new(&w, path, err);
     if (rc != BK_OK)
         return rc;
     /* Creating truncates before HDF5 would see the other run's lock: ask first. */
-    if (bk_output_write_locked(w->part)) {
+    if (bk_output_write_locked(w->part))
         rc = BK_FAIL(err, BK_ERR_IO, BK_OUTPUT_OWNED_MESSAGE, w->part);
+    if (rc == BK_OK && (rc = bk_h5_output_replaceable(path, 0, err)) == BK_OK)
+        rc = bk_h5_output_replaceable(w->part, 1, err);
+    if (rc != BK_OK) {
         bk_h5_writer_free(w);
         return rc;
     }
@@ -695,6 +694,9 @@ int bk_h5_writer_finish(bk_h5_writer *writer, const bk_run_stats *stats, bk_erro
     }
     if (bk_h5_writer_close(w) < 0 && rc == BK_OK)
         rc = H5_FAIL(err, "%s: cannot close", w->part);
+    /* Something may have been put at the final name while the run went on. */
+    if (rc == BK_OK)
+        rc = bk_h5_output_replaceable(w->path, 0, err);
     if (rc == BK_OK)
         rc = bk_output_durable_rename(w->part, w->path, err);
     if (rc != BK_OK && marked)

@@ -96,3 +96,13 @@ char *written_text(FILE *f)
     }
     return text;
 }
+
+char *file_contents(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    char *text = fseek(f, 0, SEEK_END) == 0 ? written_text(f) : NULL;
+    fclose(f);
+    return text;
+}

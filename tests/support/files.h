@@ -21,5 +21,7 @@ int copy_file(const char *src, const char *dst);
 int remove_tree(const char *path);
 /* Everything written to f so far (a tmpfile()), as a string to free; NULL on failure. */
 char *written_text(FILE *f);
+/* The whole of the file at path (malloc'ed), NULL when it cannot be read. */
+char *file_contents(const char *path);
 
 #endif
