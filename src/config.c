@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include <ini.h>
 
@@ -48,6 +49,7 @@ static void free_loader(loader *ld)
     free(ld->entries);
     free(ld->slots);
     bk_config_free_parameters(ld->parameters, ld->n_parameters);
+    bk_config_free_reader(ld);
 }
 
 /* Strip surrounding whitespace in place. */
@@ -117,8 +119,9 @@ int bk_config_load_string(const char *text, const char *name, const char *const 
     loader ld = {.name = name, .error_rank = LONG_MAX, .err = err, .status = BK_OK, .cursor = text};
     int first_bad = ini_parse_stream(bk_config_read_line, &ld, bk_config_on_pair, &ld);
     if (first_bad > 0)
-        bk_config_report(&ld, first_bad, BK_ERR_CONFIG,
-                         "%s:%d: syntax error: expected \"[section]\", \"key = value\" or a comment", name, first_bad);
+        bk_config_report(&ld, bk_config_reader_line(&ld, first_bad), BK_ERR_CONFIG,
+                         "%s:%d: syntax error: expected \"[section]\", \"key = value\" or a comment", name,
+                         bk_config_reader_line(&ld, first_bad));
     add_overrides(&ld, overrides, n_overrides);
     if (ld.oom || first_bad < 0 || bk_config_build_index(&ld) != 0) {
         free_loader(&ld);
@@ -165,6 +168,10 @@ int bk_config_load_file(const char *path, const char *const *overrides, size_t n
                         bk_config **out, bk_error *err)
 {
     *out = NULL;
+    struct stat st;
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode))
+        return BK_FAIL(err, BK_ERR_CONFIG, "%s: %s (allowed: a config file)", path,
+                       S_ISDIR(st.st_mode) ? "is a directory" : "is not a regular file");
     FILE *f = fopen(path, "rb");
     if (!f)
         return BK_FAIL(err, BK_ERR_IO, "%s: cannot open: %s", path, strerror(errno));

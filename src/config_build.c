@@ -248,7 +248,8 @@ static void check_initial_energy(loader *ld, const bk_model *m)
     free(x);
 }
 
-/* The driver: a constant velocity, or a history of velocities and durations.  Returns the
+/* The driver: a constant velocity, or a history of velocities and durations (in keys, or a
+ * table: velocities_file).  Returns the
  * history's length (s), or NAN for a constant velocity (or an error, reported). */
 static double build_driver(loader *ld, bk_model *m)
 {
@@ -256,6 +257,35 @@ static double build_driver(loader *ld, bk_model *m)
     entry *velocity = bk_config_lookup(ld, "driver", "velocity");
     entry *velocities = bk_config_lookup(ld, "driver", "velocities");
     entry *durations = bk_config_lookup(ld, "driver", "durations");
+    entry *file = bk_config_lookup(ld, "driver", "velocities_file");
+    if (file) {
+        entry *other = velocity ? velocity : velocities ? velocities : durations;
+        if (other) {
+            bk_config_report_entry(ld, other, "give velocities_file (a history from a table) or %s, not both "
+                                   "(velocities_file is %s)", other->key, file->value);
+            return NAN;
+        }
+        entry *t_end = bk_config_lookup(ld, "run", "t_end");
+        double *v = NULL, *d = NULL;
+        size_t n = 0;
+        if (bk_config_read_history(ld, file, t_end ? t_end->number : NAN, &v, &d, &n) != 0)
+            return NAN;
+        double total = 0.0;
+        for (size_t k = 0; k < n; ++k)
+            total += d[k];
+        int rc = isfinite(total) ? bk_driver_set_history(&m->driver, v, d, n) : 0;
+        free(v);
+        free(d);
+        if (!isfinite(total)) {
+            bk_config_report_entry(ld, file, "the history is longer than any finite time (allowed: a finite total)");
+            return NAN;
+        }
+        if (rc != 0) {
+            bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+            return NAN;
+        }
+        return total;
+    }
     if (velocity && velocities) {
         bk_config_report_entry(ld, velocities, "give velocity (constant) or velocities (a history), not both "
                                "(velocity is set at %s)", velocity->value);
@@ -655,6 +685,13 @@ static void build_catalog(loader *ld, bk_config *c)
     if (c->prescribed) {
         if (events && o->events)
             bk_config_report_entry(ld, events, "a prescribed scene has no slip events (allowed: false)");
+        /* Never silently: a [catalog] key would describe a catalog this scene does not keep. */
+        for (size_t i = 0; i < ld->n; ++i)
+            if (!ld->entries[i].superseded && strcmp(ld->entries[i].base, "catalog") == 0) {
+                bk_config_report_entry(ld, &ld->entries[i], "a prescribed scene keeps no catalog (allowed: no "
+                                       "[catalog] section)");
+                break;
+            }
         o->events = 0;
         return;
     }

@@ -103,6 +103,12 @@ static const key_def keys[] = {
                  "with velocities: the duration of each segment, as many as velocities; [run] t_end defaults to "
                  "their sum and may not exceed it"},
      BK_KEY_LIST, NULL, NULL, "-"},
+    {"driver", {"velocities_file", "", 0, 0, 0, 0,
+                "a history from a table instead of velocities and durations: a first line naming the columns "
+                "(velocity and duration, or velocity and t, the segments' start times from 0; the last then lasts "
+                "until [run] t_end), one line per segment, # comments; a relative path is taken from the config "
+                "file's directory"},
+     BK_KEY_TEXT, NULL, NULL, "-"},
     {"driver", {"spring", "", 0, 0, 0, 0, "driver springs: linear, or tension_only (pull, never push; NOTES.md 3)"},
      BK_KEY_CHOICE, spring_names, NULL, "linear"},
     NUM("driver", "start_position", "m", 0.0, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
@@ -183,7 +189,7 @@ static const key_def keys[] = {
                 "restart point); auto: 300 s, or 0 when checkpoint_interval is given"},
      BK_KEY_NUMBER, NULL, NULL, "auto"},
 
-    NUM("catalog", "magnitude_offset", "1", 0.0, -INFINITY, INFINITY, BK_PARAM_MIN_EXCLUSIVE | BK_PARAM_MAX_EXCLUSIVE,
+    NUM("catalog", "magnitude_offset", "1", 0.0, -100.0, 100.0, 0,
         "added to every magnitude (2/3) log10(potency / 1 m): differences are moment-magnitude differences"),
     {"catalog", {"slip_rate_threshold", "m/s", NAN, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
                  "for laws without a stuck state (dieterich_ruina_*): a block slips, for the catalog, while its "

@@ -1,6 +1,7 @@
 /* Private to the config loader, shared by its files: config_keys.c (the key table and the
  * reference), config_report.c (failures with their location), config_parse.c (text to
- * checked entries), config_random.c (values drawn per block), config_build.c (entries to a
+ * checked entries), config_random.c (values drawn per block), config_history.c (a driver
+ * history from a file), config_tables.c (the files they read), config_build.c (entries to a
  * bk_config, with the cross-key checks), config_warnings.c (plausibility warnings) and
  * config.c (the public entry points).  Not installed: the public API is
  * include/bksim/config.h. */
@@ -9,6 +10,7 @@
 
 #include <limits.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include "bksim/config.h"
 
@@ -83,9 +85,17 @@ typedef struct loader {
     int status;
     /* reader state */
     const char *cursor;
-    int line;
+    int line;                  /* the first physical line of the logical line read last */
+    int physical;              /* physical lines read */
     int section_line;          /* line of the last [section] header read */
     int oom;
+    char *logical;             /* the logical line being read (continuations joined), owned */
+    size_t logical_cap;
+    int *call_lines;           /* the line of each logical line handed to inih, in order */
+    size_t calls, calls_cap;
+    char **long_values;        /* values of lines longer than inih's buffer, owned */
+    size_t n_long, long_cap;
+    int long_line;             /* the line whose value is long_values[n_long - 1], else 0 */
     /* (section, key) -> the last live entry, so that lookups (per block, per key) cost O(1)
      * and a config with many [block.I] sections loads in linear time. */
     size_t *slots;             /* entry index + 1, 0 for an empty slot */
@@ -116,9 +126,13 @@ void bk_config_location(const loader *ld, const entry *e, char *buf, size_t len)
 
 int bk_config_add_entry(loader *ld, const char *section, const char *key, const char *value, int line,
                         const char *override, long rank);
-/* inih's reader and handler (ini_parse_stream(bk_config_read_line, ld, bk_config_on_pair, ld)). */
+/* inih's reader and handler (ini_parse_stream(bk_config_read_line, ld, bk_config_on_pair, ld)).
+ * The reader joins continuation lines and hands inih lines longer than its buffer with their
+ * value held aside; bk_config_reader_line maps inih's line count back to the file's line. */
 char *bk_config_read_line(char *str, int num, void *stream);
 int bk_config_on_pair(void *user, const char *section, const char *key, const char *value);
+int bk_config_reader_line(const loader *ld, int inih_line);
+void bk_config_free_reader(loader *ld);
 int bk_config_build_index(loader *ld);
 /* The entry of [base.i] key, or NULL; O(1) without formatting when no such section exists. */
 entry *bk_config_lookup_block(loader *ld, const char *base, size_t i, const char *key);
@@ -141,6 +155,21 @@ int bk_config_plan_parameters(loader *ld, size_t n_blocks);
 void bk_config_record_parameter(loader *ld, const char *base, const char *key, const char *unit, size_t block,
                                 double value);
 void bk_config_free_parameters(bk_block_parameter *parameters, size_t n);
+
+/* --- files a config names (config_tables.c) -------------------------------------------- */
+
+/* path as a config names it: relative to the config file's directory, unless absolute. */
+void bk_config_path_near(const loader *ld, const char *path, char *buf, size_t len);
+/* Open the table (a profile, a history) that entry e names at path: a regular file of at most
+ * max_bytes (a device or a FIFO could be read for ever); NULL, reported, otherwise. */
+FILE *bk_config_open_table(loader *ld, const entry *e, const char *path, long max_bytes, const char *what);
+
+/* --- a driver history from a file (config_history.c) ---------------------------------- */
+
+/* [driver] velocities_file e: the segments' velocities and durations (malloc'ed, *n of them;
+ * with a t column the last lasts until t_end).  0, or -1 reported with the table's file:line. */
+int bk_config_read_history(loader *ld, entry *e, double t_end, double **velocities, double **durations,
+                           size_t *n);
 
 /* --- building (config_build.c) ---------------------------------------------------------- */
 

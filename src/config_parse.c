@@ -6,8 +6,9 @@
  *
  * Parsing goes through inih with our own line reader, which counts lines (Debian's inih
  * gives the handler none), strips leading whitespace (an indented line would otherwise be
- * glued to the previous value as a continuation) and rejects over-long lines (inih would
- * silently cut them). */
+ * glued to the previous value as a continuation), joins lines ending in a backslash, and
+ * holds aside values longer than inih's 200-character buffer (inih would silently cut them):
+ * a driver history of hundreds of segments is one key. */
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -16,12 +17,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 
 #include "capacity.h"
 #include "config_loader.h"
 #include "layout.h"
-
-#define MAX_LINE_CHARS 190
 
 /* --- collected entries ------------------------------------------------------------------ */
 
@@ -76,43 +76,148 @@ int bk_config_add_entry(loader *ld, const char *section, const char *key, const 
     return 0;
 }
 
-/* fgets-style reader over the text in memory (see the file comment). */
-char *bk_config_read_line(char *str, int num, void *stream)
+/* Append len bytes to the logical line; -1 when out of memory. */
+static int logical_append(loader *ld, size_t *used, const char *text, size_t len)
 {
-    loader *ld = stream;
-    if (!*ld->cursor)
-        return NULL;
+    char *grown = bk_grow_array(ld->logical, &ld->logical_cap, *used + len + 1, 1, 256);
+    if (!grown)
+        return -1;
+    ld->logical = grown;
+    memcpy(ld->logical + *used, text, len);
+    *used += len;
+    ld->logical[*used] = '\0';
+    return 0;
+}
+
+/* The next physical line (LF, CRLF or a lone CR ends it: old Mac files), its leading blanks
+ * dropped, appended to the logical line; 1 when it ends in a backslash that continues it. */
+static int read_physical(loader *ld, size_t *used)
+{
     const char *start = ld->cursor;
-    /* Lines end in LF, CRLF or a lone CR (old Mac files). */
     const char *eol = strpbrk(start, "\r\n");
     size_t content = eol ? (size_t)(eol - start) : strlen(start);
-    size_t len = content + (eol ? (eol[0] == '\r' && eol[1] == '\n' ? 2 : 1) : 0);
-    ld->cursor = start + len;
-    ld->line++;
-    if (content > MAX_LINE_CHARS) {
-        char where[300];
-        snprintf(where, sizeof where, "%s:%d", ld->name, ld->line);
-        bk_config_report(ld, ld->line, BK_ERR_CONFIG, "%s: line longer than %d characters (%zu); split it",
-                         where, MAX_LINE_CHARS, content);
-        content = 0;
+    ld->cursor = start + content + (eol ? (eol[0] == '\r' && eol[1] == '\n' ? 2 : 1) : 0);
+    ld->physical++;
+    if (ld->physical == 1 && content >= 3 && memcmp(start, "\xEF\xBB\xBF", 3) == 0) {
+        start += 3; /* a UTF-8 byte order mark */
+        content -= 3;
     }
     while (content > 0 && (*start == ' ' || *start == '\t')) {
         ++start;
         --content;
     }
-    if (content > 0 && *start == '[')
+    size_t before = *used;
+    if (logical_append(ld, used, start, content) != 0) {
+        ld->oom = 1;
+        return 0;
+    }
+    while (*used > before && (ld->logical[*used - 1] == ' ' || ld->logical[*used - 1] == '\t'))
+        ld->logical[--*used] = '\0';
+    int comment = ld->logical[0] == ';' || ld->logical[0] == '#';
+    if (comment || *used == before || ld->logical[*used - 1] != '\\' || !*ld->cursor)
+        return 0;
+    ld->logical[*used - 1] = ' '; /* the backslash: the pieces are joined by a blank */
+    return 1;
+}
+
+/* A value too long for inih's buffer: its inline comment (";" after a blank) and blanks
+ * dropped, held aside; inih gets "key = \1" and bk_config_on_pair puts it back.  0, or -1
+ * when the line is none of inih's (a section header). */
+static int hold_long_value(loader *ld, char *str, int num)
+{
+    char *text = ld->logical;
+    if (text[0] == ';' || text[0] == '#') { /* a comment: nothing to hand over */
+        snprintf(str, (size_t)num, "\n");
+        return 0;
+    }
+    char *sep = strpbrk(text, "=:");
+    if (text[0] == '[' || !sep || (size_t)(sep - text) + 8 > (size_t)num)
+        return -1;
+    char *value = sep + 1;
+    while (*value == ' ' || *value == '\t')
+        ++value;
+    for (char *c = value; *c; ++c)
+        if (*c == ';' && c > value && (c[-1] == ' ' || c[-1] == '\t')) {
+            *c = '\0';
+            break;
+        }
+    size_t len = strlen(value);
+    while (len > 0 && (value[len - 1] == ' ' || value[len - 1] == '\t'))
+        value[--len] = '\0';
+    char **grown = bk_grow_array(ld->long_values, &ld->long_cap, ld->n_long + 1, sizeof *grown, 8);
+    char *kept = grown ? strdup(value) : NULL;
+    if (!kept) {
+        ld->oom = 1;
+        snprintf(str, (size_t)num, "\n");
+        return 0;
+    }
+    ld->long_values = grown;
+    ld->long_values[ld->n_long++] = kept;
+    ld->long_line = ld->line;
+    snprintf(str, (size_t)num, "%.*s= \001\n", (int)(sep - text), text);
+    return 0;
+}
+
+/* fgets-style reader over the text in memory (see the file comment): one logical line per
+ * call, continuation lines (ending in a backslash) joined. */
+char *bk_config_read_line(char *str, int num, void *stream)
+{
+    loader *ld = stream;
+    if (!*ld->cursor)
+        return NULL;
+    size_t used = 0;
+    if (logical_append(ld, &used, "", 0) != 0) {
+        ld->oom = 1;
+        return NULL;
+    }
+    ld->line = ld->physical + 1;
+    while (read_physical(ld, &used))
+        ;
+    int *lines = bk_grow_array(ld->call_lines, &ld->calls_cap, ld->calls + 1, sizeof *lines, 64);
+    if (!lines) {
+        ld->oom = 1;
+        return NULL;
+    }
+    ld->call_lines = lines;
+    ld->call_lines[ld->calls++] = ld->line;
+    if (used > 0 && ld->logical[0] == '[')
         ld->section_line = ld->line;
-    if ((int)content + 2 > num)
-        content = (size_t)num - 2;
-    memcpy(str, start, content);
-    str[content] = '\n';
-    str[content + 1] = '\0';
+    if ((int)used + 2 <= num) {
+        memcpy(str, ld->logical, used);
+        str[used] = '\n';
+        str[used + 1] = '\0';
+    } else if (hold_long_value(ld, str, num) != 0) {
+        char where[300];
+        snprintf(where, sizeof where, "%s:%d", ld->name, ld->line);
+        bk_config_report(ld, ld->line, BK_ERR_CONFIG,
+                         "%s: a section header or key of %zu characters (allowed: at most %d; only values may be "
+                         "longer)",
+                         where, used, num - 8);
+        snprintf(str, (size_t)num, "\n");
+    }
     return str;
+}
+
+int bk_config_reader_line(const loader *ld, int inih_line)
+{
+    return inih_line >= 1 && (size_t)inih_line <= ld->calls ? ld->call_lines[inih_line - 1] : inih_line;
+}
+
+void bk_config_free_reader(loader *ld)
+{
+    free(ld->logical);
+    free(ld->call_lines);
+    for (size_t k = 0; k < ld->n_long; ++k)
+        free(ld->long_values[k]);
+    free(ld->long_values);
 }
 
 int bk_config_on_pair(void *user, const char *section, const char *key, const char *value)
 {
     loader *ld = user;
+    /* A long line's value, held aside by the reader. */
+    if (value[0] == '\001' && value[1] == '\0' && ld->long_line == ld->line && ld->n_long > 0)
+        value = ld->long_values[ld->n_long - 1];
     if (bk_config_add_entry(ld, section, key, value, ld->line, NULL, ld->line) != 0)
         ld->oom = 1;
     else
@@ -131,9 +236,12 @@ static int parse_number(const char *text, double *out)
     double value = strtod(text, &end);
     while (end && isspace((unsigned char)*end))
         ++end;
-    /* ERANGE on underflow (1e-320) is a tiny number, which the ranges then judge. */
+    /* ERANGE on underflow (1e-320) is a tiny number, which the ranges then judge; one below
+     * every double (1e-400) would silently be 0. */
     if (end == text || *end != '\0' || (errno == ERANGE && fabs(value) >= 1.0) || !isfinite(value))
         return -1;
+    if (errno == ERANGE && value == 0.0)
+        return -2;
     *out = value;
     return 0;
 }
@@ -187,6 +295,33 @@ static int next_word(const char **p, const char **start, size_t *len)
     return 1;
 }
 
+/* The position (1-based) of the first empty item of a list whose items are separated by
+ * commas and/or blanks: "1e-3,,0" has an empty item 2, and a comma first or last one too;
+ * 0 when there is none.  Blanks alone never make an empty item. */
+static size_t empty_item(const char *text)
+{
+    size_t items = 0;
+    int after_comma = 1; /* the start is like a comma: "," first is an empty item 1 */
+    int seen_any = 0;
+    for (const char *p = text; *p;) {
+        if (isspace((unsigned char)*p)) {
+            ++p;
+        } else if (*p == ',') {
+            if (after_comma)
+                return items + 1;
+            after_comma = 1;
+            ++p;
+        } else {
+            ++items;
+            seen_any = 1;
+            after_comma = 0;
+            while (*p && *p != ',' && !isspace((unsigned char)*p))
+                ++p;
+        }
+    }
+    return after_comma && seen_any ? items + 1 : 0;
+}
+
 /* Parse a "fields" list into a BK_FIELD_* mask; -1 and the bad word on failure. */
 static int parse_fields(const char *text, double *out, char *bad, size_t bad_len)
 {
@@ -233,6 +368,11 @@ int bk_config_check_value(loader *ld, entry *e, const key_def *def, const bk_par
         if (drawn != 0)
             return drawn < 0 ? -1 : 0;
         int bad = type == BK_KEY_INTEGER ? parse_integer(v, &e->number) : parse_number(v, &e->number);
+        if (bad == -2) {
+            bk_config_report_entry(ld, e, "%s is smaller than any double (it would be read as 0; write 0 if that is "
+                                   "meant) (allowed: %s)", v, allowed);
+            return -1;
+        }
         if (bad) {
             const char *hint = strchr(v, '#') ? " (inline comments start with ';')" : "";
             bk_config_report_entry(ld, e, "%s \"%s\"%s (allowed: %s)",
@@ -279,11 +419,17 @@ int bk_config_check_value(loader *ld, entry *e, const key_def *def, const bk_par
         }
         const char *p = v, *start;
         size_t len;
+        size_t empty = empty_item(v);
+        if (empty > 0) {
+            bk_config_report_entry(ld, e, "item %zu is empty (two commas, or a comma at an end) (allowed: %s)",
+                                   empty, allowed);
+            return -1;
+        }
         while (next_word(&p, &start, &len)) {
             char word[64];
             snprintf(word, sizeof word, "%.*s", (int)len, start);
             double x;
-            if (parse_number(word, &x) || !bk_param_in_range(param, x)) {
+            if (len >= sizeof word || parse_number(word, &x) != 0 || !bk_param_in_range(param, x)) {
                 bk_config_report_entry(ld, e, "bad value \"%s\" (item %zu) (allowed: %s)", word, count + 1, allowed);
                 return -1;
             }
@@ -418,12 +564,19 @@ void bk_config_check_entries(loader *ld, long n_blocks)
             known_section |= strcmp(bk_config_sections[s], e->base) == 0;
         int per_block_ok = strcmp(e->base, "block") == 0 || strcmp(e->base, "friction") == 0;
         if (!known_section || e->index == -2 || (e->index >= 0 && !per_block_ok)) {
-            char where[512];
+            char where[512], sections[256] = "";
             section_location(ld, e, where, sizeof where);
+            /* From the table, so that no section is left out of the list. */
+            size_t used = 0;
+            for (size_t s = 0; bk_config_sections[s] && used < sizeof sections; ++s) {
+                int per_block = strcmp(bk_config_sections[s], "block") == 0 || strcmp(bk_config_sections[s], "friction") == 0;
+                used += (size_t)snprintf(sections + used, sizeof sections - used, "%s%s%s%s", s ? ", " : "",
+                                         bk_config_sections[s], per_block ? ", " : "",
+                                         per_block ? (strcmp(bk_config_sections[s], "block") == 0 ? "block.I" : "friction.I") : "");
+            }
             bk_config_report(ld, e->section_line ? e->section_line : e->rank, BK_ERR_CONFIG,
-                             "%s: [%s]: unknown section (allowed: model, block, block.I, friction, friction.I, "
-                             "driver, solver, output, run; I is a block index from 0)",
-                             where, e->section);
+                             "%s: [%s]: unknown section (allowed: %s; I is a block index from 0)", where, e->section,
+                             sections);
             continue;
         }
         if (e->index >= 0 && n_blocks > 0 && e->index >= n_blocks) {

@@ -14,7 +14,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
@@ -163,11 +162,7 @@ static void profile_path(const loader *ld, const entry *e, char *buf, size_t len
     long column = 1;
     if (split_file(e->value, path, sizeof path, &column) < 0)
         path[0] = '\0';
-    const char *slash = strrchr(ld->name, '/');
-    if (path[0] == '/' || !slash)
-        snprintf(buf, len, "%s", path);
-    else
-        snprintf(buf, len, "%.*s/%s", (int)(slash - ld->name), ld->name, path);
+    bk_config_path_near(ld, path, buf, len);
 }
 
 /* Read the column of a file(...) profile: one value per line that is neither blank nor a
@@ -177,20 +172,9 @@ static int read_profile(loader *ld, entry *e)
     char path[PATH_MAX + 256];
     profile_path(ld, e, path, sizeof path);
     size_t column = (size_t)e->dist_a, n_blocks = ld->rows * ld->cols;
-    /* A regular file of bounded size: a device or a FIFO could be read for ever. */
-    struct stat st;
-    if (stat(path, &st) == 0 && (!S_ISREG(st.st_mode) || st.st_size > MAX_PROFILE_BYTES)) {
-        bk_config_report_entry(ld, e, "%s: %s (allowed: a regular file of at most %d MB)", path,
-                               S_ISREG(st.st_mode) ? "too large for a profile" : "not a regular file",
-                               MAX_PROFILE_BYTES >> 20);
+    FILE *f = bk_config_open_table(ld, e, path, MAX_PROFILE_BYTES, "profile");
+    if (!f)
         return -1;
-    }
-    FILE *f = fopen(path, "r");
-    if (!f) {
-        bk_config_report_entry(ld, e, "%s: cannot open the profile: %s (a relative path is taken from the "
-                               "config file's directory)", path, strerror(errno));
-        return -1;
-    }
     e->profile = malloc((n_blocks ? n_blocks : 1) * sizeof *e->profile);
     e->profile_lines = malloc((n_blocks ? n_blocks : 1) * sizeof *e->profile_lines);
     if (!e->profile || !e->profile_lines) {

@@ -162,9 +162,13 @@ int bk_stats_report_text(const bk_stats_report *r, FILE *out, bk_error *err)
     }
     bk_stats_text_sequences(r, out);
     bk_stats_text_scaling(r, out);
-    if (r->have_sizes)
-        fprintf(out, "sizes: %zu complete events, 1 to %d blocks, mean %.4g\n", r->sizes.n_events,
+    if (r->have_sizes) {
+        int smallest = 0; /* the counts hold it: sizes begin at 1 only where an event of one block was */
+        while (smallest < r->sizes.max_size && r->sizes.count[smallest] == 0)
+            ++smallest;
+        fprintf(out, "sizes: %zu complete events, %d to %d blocks, mean %.4g\n", r->sizes.n_events, smallest,
                 (int)r->sizes.max_size, r->sizes.mean);
+    }
     else
         fprintf(out, "sizes: not available: %s\n", r->sizes_note);
     if (r->have_ks)

@@ -63,6 +63,15 @@ static void test_bad_inputs(void **state)
         {"n_blocks = 1", "rows = 2\ncols = 2.5", "bad.ini:3: [model] cols:"},
         {"n_blocks = 1", "rows = 2000\ncols = 2000", "bad.ini:3: [model] cols: rows * cols = 4000000 blocks (allowed: at most 1000000)"},
         {"n_blocks = 1", "n_blocks = 4\nboundary_rows = twisted", "bad.ini:3: [model] boundary_rows:"},
+        /* Messages that once were untrue or silent (issue 35, part 8). */
+        {"[model]", "[modle]", "bad.ini:1: [modle]: unknown section (allowed: model, block, block.I, friction, "
+                               "friction.I, driver, solver, output, catalog, run, prescribed; I is a block index"},
+        {"velocity = 1e-3", "velocity = 1e-400", "bad.ini:11: [driver] velocity: 1e-400 is smaller than any double "
+                                                 "(it would be read as 0; write 0 if that is meant)"},
+        {"t_end = 0.7", "t_end = 0.7\n[catalog]\nmagnitude_offset = 1e308",
+         "bad.ini:15: [catalog] magnitude_offset: out of range, got 1e308 (allowed: -100 <= magnitude_offset <= 100)"},
+        {"velocity = 1e-3", "velocities = 1e-3,,0\ndurations = 1, 1, 1",
+         "bad.ini:11: [driver] velocities: item 2 is empty"},
     };
     char path[512], out[512], cmd[2048], cwd[1024];
     assert_non_null(getcwd(cwd, sizeof cwd));
@@ -87,6 +96,12 @@ static void test_bad_inputs(void **state)
         snprintf(cmd, sizeof cmd, "cd %s && %s/%s check bad.ini", tmpdir, cwd, bksim_binary());
         assert_int_equal(run_command(cmd, NULL), 2);
     }
+    /* A directory given as the config: a usage error, exit 2. */
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s", tmpdir, out);
+    expect_command(cmd, 2, "is a directory (allowed: a config file)");
+    /* [catalog] in a prescribed scene describes nothing: refused, not ignored. */
+    expect_command("./bksim check configs/paper/fig2_velocity_step.ini --set catalog.rupture_rate=false", 2,
+                   "[catalog] rupture_rate: a prescribed scene keeps no catalog");
     /* An unreadable config: I/O failure, exit 1, nothing written. */
     snprintf(cmd, sizeof cmd, "./bksim run %s/missing.ini -o %s", tmpdir, out);
     char *text = NULL;

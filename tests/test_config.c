@@ -540,15 +540,16 @@ static void test_quasi_dynamic(void **state)
 static void test_rejections(void **state)
 {
     (void)state;
-    char long_line[300];
+    char long_line[300]; /* a section header longer than inih's line: only values may be */
     memset(long_line, 'y', 250);
-    memcpy(long_line, "mass = 1 ;", 10);
+    long_line[0] = '[';
+    long_line[249] = ']';
     long_line[250] = '\n';
     long_line[251] = '\0';
     const rejection cases[] = {
         {"[model]\n", "[modle]\n",
          "t.ini:1: [modle]: unknown section (allowed: model, block, block.I, friction, friction.I, driver, "
-         "solver, output, run; I is a block index from 0)"},
+         "solver, output, catalog, run, prescribed; I is a block index from 0)"},
         {"mass = 1\n", "mass = 1\nmas = 2\n",
          "t.ini:5: [block] mas: unknown key (allowed: mass, driver_stiffness, normal_force, x_init, v_init, x_init_random, damping, applied_force)"},
         {"mass = 1\n", "mass = 1\nmass = 2\n", "t.ini:5: [block] mass: duplicate key (first set at line 4)"},
@@ -603,7 +604,18 @@ static void test_rejections(void **state)
         {"mass = 1\n", "mass = 1\n[block.1]\nmass = 2\n", "t.ini:5: [block.1]: block index out of range (allowed: 0..0)"},
         {"mass = 1\n", "mass = 1\n[block.x]\nmass = 2\n", "t.ini:5: [block.x]: unknown section"},
         {"mass = 1\n", "mass = 1\n[driver.0]\nvelocity = 2\n", "t.ini:5: [driver.0]: unknown section"},
-        {"mass = 1\n", long_line, "t.ini:4: line longer than 190 characters (250); split it"},
+        {"mass = 1\n", long_line, "t.ini:4: a section header or key of 250 characters (allowed: at most 192; only "
+                                  "values may be longer)"},
+        {"velocity = 1e-3\n", "velocities = 1e-3,,0\ndurations = 1, 1\n",
+         "t.ini:11: [driver] velocities: item 2 is empty (two commas, or a comma at an end)"},
+        {"velocity = 1e-3\n", "velocities = 1e-3, \\\n   0,\ndurations = 1, 1\n",
+         "t.ini:11: [driver] velocities: item 3 is empty"},
+        {"velocity = 1e-3\n", "velocities = 1e-3 \\\n 0\ndurations = 1, \\\n 1\nspring = elastic\n",
+         "t.ini:15: [driver] spring: unknown value \"elastic\""},
+        {"velocity = 1e-3\n", "velocities_file = /nonexistent/h.tsv\n",
+         "t.ini:11: [driver] velocities_file: /nonexistent/h.tsv: cannot open the history"},
+        {"velocity = 1e-3\n", "velocity = 1e-3\nvelocities_file = /nonexistent/h.tsv\n",
+         "t.ini:11: [driver] velocity: give velocities_file (a history from a table) or velocity, not both"},
         {"mass = 1\n", "mass 1\n", "t.ini:4: syntax error"},
         {"[block]\n", "[block\n", "t.ini:3: syntax error"},
         {"mass = 1\n", "mass = 0x1p0\n", "t.ini:4: [block] mass: not a number: \"0x1p0\""},
@@ -978,6 +990,125 @@ static void test_reference(void **state)
  * column of a file beside the config (comments and blank lines skipped); every block's value
  * is kept for /parameters; a file's bad line is named with the config's key. */
 #define PROFILE_TAIL "[friction]\nlaw = coulomb\nmu_s = 1\nmu_d = 0\n[driver]\nvelocity = 0\n[run]\nt_end = 1\n"
+/* A driver history of 400 segments (slide-hold-slide, 0.5 s each), written four ways: one line
+ * of 2,400 characters (longer than inih's buffer), continuation lines, and a table of
+ * durations or of start times (velocities_file): the same driver, bit for bit. */
+static void test_long_protocols(void **state)
+{
+    (void)state;
+    enum { N = 400 };
+    size_t cap = 64 * N + 1024;
+    char *one_line = malloc(cap), *continued = malloc(cap), *durations = malloc(cap);
+    char *by_duration = malloc(cap), *by_time = malloc(cap);
+    assert_true(one_line && continued && durations && by_duration && by_time);
+    size_t a = 0, b = 0, d = 0, f = 0, g = 0;
+    /* A comment longer than inih's line is skipped too. */
+    a += (size_t)sprintf(one_line + a, "; %0300d\n", 0);
+    a += (size_t)sprintf(one_line + a, "velocities = ");
+    b += (size_t)sprintf(continued + b, "velocities = ");
+    d += (size_t)sprintf(durations + d, "durations =");
+    f += (size_t)sprintf(by_duration + f, "# a protocol\nduration[s]\tvelocity[m/s]\n");
+    g += (size_t)sprintf(by_time + g, "velocity, t\n");
+    for (int k = 0; k < N; ++k) {
+        double v = k % 2 ? 0.0 : 1e-3 * (1 + k % 3);
+        a += (size_t)sprintf(one_line + a, "%s%.17g", k ? ", " : "", v);
+        b += (size_t)sprintf(continued + b, "%.17g%s\n", v, k + 1 < N ? ", \\" : "   ; the last");
+        d += (size_t)sprintf(durations + d, " 0.5");
+        f += (size_t)sprintf(by_duration + f, "0.5 %.17g  # segment %d\n", v, k);
+        g += (size_t)sprintf(by_time + g, "%.17g,%g\n", v, 0.5 * k);
+    }
+    sprintf(one_line + a, "   ; %d segments on one line\n%s\n", N, durations);
+    sprintf(continued + b, "%s\n", durations);
+    char dir[256], name[512], path[512];
+    assert_int_equal(make_temp_dir(dir, sizeof dir, "bksim_history"), 0);
+    snprintf(name, sizeof name, "%s/scene.ini", dir);
+    snprintf(path, sizeof path, "%s/by_duration.tsv", dir);
+    assert_int_equal(write_text(path, by_duration), 0);
+    snprintf(path, sizeof path, "%s/by_time.csv", dir);
+    assert_int_equal(write_text(path, by_time), 0);
+    const char *driver_keys[4] = {one_line, continued, "velocities_file = by_duration.tsv\n",
+                                  "velocities_file = by_time.csv\n"};
+    double *first_position = NULL;
+    for (int way = 0; way < 4; ++way) {
+        char *text = malloc(cap + 512);
+        assert_non_null(text);
+        sprintf(text, "[model]\nn_blocks = 1\n[block]\nmass = 1\ndriver_stiffness = 1e4\n"
+                      "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n[driver]\n%s[run]\n%s",
+                driver_keys[way], way == 3 ? "t_end = 200\n" : "");
+        bk_config *c = NULL;
+        bk_error err = {0};
+        int rc = bk_config_load_string(text, name, NULL, 0, &c, &err);
+        if (rc != BK_OK)
+            fail_msg("way %d: %s", way, err.message);
+        const bk_driver *drv = &c->model->driver;
+        assert_int_equal(drv->n_segments, N);
+        assert_true(c->t_end == 200.0);
+        for (size_t k = 0; k < N; ++k) {
+            assert_true(drv->segment_velocity[k] == (k % 2 ? 0.0 : 1e-3 * (double)(1 + k % 3)));
+            assert_true(drv->segment_start[k] == 0.5 * (double)k);
+        }
+        if (way == 0) {
+            first_position = malloc(N * sizeof *first_position);
+            assert_non_null(first_position);
+            for (size_t k = 0; k < N; ++k)
+                first_position[k] = drv->segment_position[k];
+        } else {
+            for (size_t k = 0; k < N; ++k)
+                assert_true(drv->segment_position[k] == first_position[k]);
+        }
+        bk_config_free(c);
+        free(text);
+    }
+    print_message("%d segments: one config of %zu characters, %d continuation lines and two tables agree\n", N,
+                  strlen(one_line), N);
+
+    /* Bad tables name their file:line. */
+    static const struct {
+        const char *table, *message;
+    } bad[] = {
+        {"velocity duration\n1e-3 0.5\n1e-3\n", "bad.tsv:3: one column"},
+        {"velocity duration\n1e-3 0.5\n1e-3 0\n", "bad.tsv:3: duration 0 (allowed: > 0 s)"},
+        {"velocity duration\n1e-3 0.5x\n", "bad.tsv:2: not a finite number: \"0.5x\""},
+        {"t velocity\n0.1 1e-3\n", "bad.tsv:2: the first segment starts at t = 0.10000000000000001 s (allowed: 0)"},
+        {"t velocity\n0 1e-3\n# hold\n2 0\n1 1e-3\n", "bad.tsv:5: t = 1 s after t = 2 s (allowed: increasing times)"},
+        {"v duration\n", "bad.tsv:1: the first line names the columns: \"v duration\""},
+        {"# nothing\n\n", "bad.tsv: empty"},
+        {"velocity duration\n", "bad.tsv: no segments"},
+    };
+    snprintf(path, sizeof path, "%s/bad.tsv", dir);
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+        assert_int_equal(write_text(path, bad[k].table), 0);
+        bk_config *c = NULL;
+        bk_error err = {0};
+        assert_int_equal(bk_config_load_string("[model]\nn_blocks = 1\n[block]\nmass = 1\ndriver_stiffness = 1e4\n"
+                                               "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n[driver]\n"
+                                               "velocities_file = bad.tsv\n[run]\nt_end = 1\n",
+                                               name, NULL, 0, &c, &err),
+                         BK_ERR_CONFIG);
+        if (!strstr(err.message, bad[k].message))
+            fail_msg("table %zu: expected \"%s\" in \"%s\"", k, bad[k].message, err.message);
+        assert_non_null(strstr(err.message, "scene.ini:11: [driver] velocities_file: "));
+    }
+    /* A t table without [run] t_end cannot say how long its last segment lasts. */
+    assert_int_equal(write_text(path, "t velocity\n0 1e-3\n"), 0);
+    bk_config *c = NULL;
+    bk_error err = {0};
+    assert_int_equal(bk_config_load_string("[model]\nn_blocks = 1\n[block]\nmass = 1\ndriver_stiffness = 1e4\n"
+                                           "[friction]\nlaw = coulomb\nmu_s = 0.6\nmu_d = 0.5\n[driver]\n"
+                                           "velocities_file = bad.tsv\n",
+                                           name, NULL, 0, &c, &err),
+                     BK_ERR_CONFIG);
+    assert_non_null(strstr(err.message, "bad.tsv:2: the last segment starts at t = 0 s; with a t column it lasts "
+                                        "until [run] t_end, which must be given"));
+    assert_int_equal(remove_tree(dir), 0);
+    free(first_position);
+    free(one_line);
+    free(continued);
+    free(durations);
+    free(by_duration);
+    free(by_time);
+}
+
 static void test_profiles(void **state)
 {
     (void)state;
@@ -1059,6 +1190,7 @@ int main(void)
         cmocka_unit_test(test_checkpoint_keys),
         cmocka_unit_test(test_distributions),
         cmocka_unit_test(test_profiles),
+        cmocka_unit_test(test_long_protocols),
         cmocka_unit_test(test_event_rows_auto),
         cmocka_unit_test(test_tolerated_forms),
         cmocka_unit_test(test_rejections),

@@ -743,7 +743,19 @@ static void test_report_bksim_catalog(void **state)
     assert_non_null(strstr(text, "left out: 1 still running at the end (complete = 0), 1 without"));
     assert_non_null(strstr(text, "b-value: "));
     assert_non_null(strstr(text, "maximum curvature + 0.2"));
+    assert_non_null(strstr(text, "complete events, 1 to 1000 blocks, mean "));
     free(text);
+    /* The smallest size is the catalog's, not a fixed 1 (it once always said "1 to"). */
+    const size_t kept[3] = {rep->sizes.count[0], rep->sizes.count[1], rep->sizes.count[2]};
+    rep->sizes.count[0] = rep->sizes.count[1] = rep->sizes.count[2] = 0;
+    f = tmpfile();
+    assert_int_equal(bk_stats_report_text(rep, f, &err), BK_OK);
+    text = read_text(f);
+    fclose(f);
+    assert_non_null(strstr(text, "complete events, 3 to 1000 blocks, mean "));
+    free(text);
+    for (size_t s = 0; s < 3; ++s)
+        rep->sizes.count[s] = kept[s];
 
     assert_int_equal(bk_stats_report_tsv(rep, tsv, &err), BK_OK);
     snprintf(file, sizeof file, "%s/mfd.tsv", tsv);
