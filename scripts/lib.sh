@@ -138,6 +138,13 @@ bk_run_at_exit() {
 }
 
 # bk_temp_dir VAR: a new temporary directory into VAR, removed with its contents at exit.
+# bk_sample_rows FILE: the regular sample rows of a run's output (not the rows at transition
+# instants), with bksim set (bk_find_bksim).  Two (t = 0 and t_end) means [output] interval = 0:
+# nothing between its transitions is in the file.
+bk_sample_rows() {
+    "$bksim" export "$1" --datasets event 2> /dev/null | awk '!/^#/ && $1 == 0 {n++} END {print n+0}'
+}
+
 bk_temp_dir() {
     local _bk_dir
     _bk_dir=$(mktemp -d) || bk_fail 1 "cannot create a temporary directory"

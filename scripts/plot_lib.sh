@@ -107,3 +107,21 @@ plot_draw() {
     PLOT_PARTIAL=""
     outputs+=("$1")
 }
+
+# plot_file_shape FILE: the chain's length and the lattice's shape from bksim info (its exit
+# status says whether the run finished, which does not matter here): sets n_blocks (empty when
+# info gives none: another program's catalog), rows and cols ("lattice R x C blocks ...", or no
+# such line for a chain, one row).  A lattice line that does not read so is an error, never a
+# chain drawn in its place.
+plot_file_shape() {
+    local info shape
+    info=$({ "$bksim" info "$1" 2>/dev/null || true; })
+    n_blocks=$(awk '$1 == "n_blocks" {print $2; exit}' <<<"$info")
+    [[ ${n_blocks:-} =~ ^[0-9]+$ ]] || { n_blocks="" rows=1 cols=""; return 0; }
+    shape=$(awk '$1 == "lattice" {
+            print ($2 ~ /^[0-9]+$/ && $3 == "x" && $4 ~ /^[0-9]+$/) ? $2 " " $4 : "unreadable"; exit
+        }' <<<"$info")
+    [ "$shape" != unreadable ] || bk_fail 1 "$1: cannot read the lattice's shape from bksim info: $(grep '^lattice' <<<"$info")"
+    read -r rows cols <<<"${shape:-1 $n_blocks}"
+    [ "$((rows * cols))" -eq "$n_blocks" ] || bk_fail 1 "$1: a $rows x $cols lattice of $n_blocks blocks"
+}

@@ -13,7 +13,9 @@
 #   OUTDIR/<stem>_ruptures_spacetime.<fmt>  every rupture's (event's) extent (blocks
 #       (events: <stem>_spacetime.<fmt>)    left..right) at its start time, coloured by
 #                                           magnitude; one that wraps past block 0 on a ring
-#                                           (left > right) is drawn as two segments.
+#                                           (left > right) is drawn as two segments.  A chain
+#                                           only: on a lattice left..right bound a box, and
+#                                           the plot is left out with a warning.
 # The statistics are `bksim stats FILE --table TABLE` (complete rows only; Mc by maximum
 # curvature + 0.2, bins of 0.1); the rows are `bksim export FILE --table TABLE` (every row,
 # running ones too).  A file without the table is an error (an older file has no /ruptures:
@@ -57,10 +59,9 @@ n_mc=$(json n_above_mc); mc=$(json mc); b=$(json b_value); b_err=$(json b_value_
 dm=$(json bin); m_max=$(json magnitude_max)
 [ "$n_rows" -gt 0 ] || bk_fail 1 "$file: /$table is empty: nothing to plot"
 
-# The chain's length (bksim info; its exit status says whether the run finished, which
-# does not matter here), else the largest block an event reached.
-n_blocks=$({ "$bksim" info "$file" 2>/dev/null || true; } | awk '$1 == "n_blocks" {print $2; exit}')
-if ! [[ $n_blocks =~ ^[0-9]+$ ]]; then
+# The chain's length and shape (plot_file_shape), else the largest block an event reached.
+plot_file_shape "$file"
+if [ -z "$n_blocks" ]; then
     n_blocks=$(awk -F'\t' '!/^#/ {m = $5 > m ? $5 : m; m = $6 > m ? $6 : m} END {print m + 1}' \
         "$tmp/events.tsv")
 fi
@@ -147,6 +148,13 @@ else
 fi
 
 # ------------------------------------------------------------- (b) space-time ---
+# On a lattice left..right are the flat indices of a bounding box, not a span of blocks: a
+# segment between them would draw blocks that did not slip.
+if [ "$rows" -gt 1 ]; then
+    bk_warn "$file: a $rows x $cols lattice: no space-time plot (left..right are the flat block indices of a bounding box, not a span of blocks; plot_slip_map.sh maps a rupture's own blocks)"
+    echo "$mfd_out"
+    exit 0
+fi
 # Segments t, from, to, magnitude, the blocks as cells [i - 1/2, i + 1/2]; a wrapping event
 # gives two.  Sorted by magnitude, so that the larger events are drawn on top.  Events of
 # zero potency (magnitude -inf) go to a file of their own, drawn grey.

@@ -79,17 +79,8 @@ fi
 IFS=$'\t' read -r t_start _ first_block r_blocks left right _ potency magnitude _ _ duration \
     v_left v_right complete < <(awk -F'\t' -v k="$rupture" '!/^#/ && n++ == k' "$tmp/ruptures.tsv")
 
-# The chain's length and the lattice's shape (bksim info; its exit status says whether the
-# run finished, which does not matter here).
-info=$({ "$bksim" info "$file" 2>/dev/null || true; })
-n_blocks=$(awk '$1 == "n_blocks" {print $2; exit}' <<<"$info")
-[[ ${n_blocks:-} =~ ^[0-9]+$ ]] || bk_fail 1 "$file: bksim info gives no n_blocks"
-shape=$(awk '$1 == "lattice" {
-        print ($2 ~ /^[0-9]+$/ && $3 == "x" && $4 ~ /^[0-9]+$/) ? $2 " " $4 : "unreadable"; exit
-    }' <<<"$info")
-[ "$shape" != unreadable ] || bk_fail 1 "$file: cannot read the lattice's shape from bksim info: $(grep '^lattice' <<<"$info")"
-read -r rows cols <<<"${shape:-1 $n_blocks}"
-[ "$((rows * cols))" -eq "$n_blocks" ] || bk_fail 1 "$file: a $rows x $cols lattice of $n_blocks blocks"
+plot_file_shape "$file"
+[ -n "$n_blocks" ] || bk_fail 1 "$file: bksim info gives no n_blocks"
 
 export_table rupture_blocks "$tmp/blocks.tsv"
 awk -F'\t' -v k="$rupture" '!/^#/ && $1 == k' "$tmp/blocks.tsv" > "$tmp/one.tsv"

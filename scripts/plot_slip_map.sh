@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # One rupture's (or event's) slip over a 2D lattice, as a map of rows x cols cells (block i
-# at row i / cols, column i % cols; row 0 on top; a chain is one row), each coloured by how
-# far block i slipped (m):
+# at row i / cols, column i % cols; row 0 on top), each coloured by how far block i slipped
+# (m); over a chain, slip against block, a bar each:
 #   OUTDIR/<stem>_rupture_<K>_slip_map.<fmt>  row K of the rupture catalog /ruptures (the
 #       default; --rupture K): the slip of each of its blocks from /rupture_blocks, x at its
 #       last stop minus x at its first onset in the rupture: exact, whatever the file keeps;
@@ -76,18 +76,8 @@ IFS=$'\t' read -r t_start t_end first_block ev_blocks left right _ _ magnitude _
     awk -F'\t' -v k="$event" -v ruptures="$([ "$table" = ruptures ] && echo 1 || echo 0)" '
         !/^#/ && n++ == k { if (ruptures) $12 = $15; NF = 12; print }' OFS='\t' "$tmp/events.tsv")
 
-# The lattice's shape (bksim info; its exit status says whether the run finished, which
-# does not matter here): "lattice R x C blocks ...", or no such line for a chain, one row.
-# A lattice line that does not read so is an error, never a chain drawn in its place.
-info=$({ "$bksim" info "$file" 2>/dev/null || true; })
-n_blocks=$(awk '$1 == "n_blocks" {print $2; exit}' <<<"$info")
-[[ ${n_blocks:-} =~ ^[0-9]+$ ]] || bk_fail 1 "$file: bksim info gives no n_blocks"
-shape=$(awk '$1 == "lattice" {
-        print ($2 ~ /^[0-9]+$/ && $3 == "x" && $4 ~ /^[0-9]+$/) ? $2 " " $4 : "unreadable"; exit
-    }' <<<"$info")
-[ "$shape" != unreadable ] || bk_fail 1 "$file: cannot read the lattice's shape from bksim info: $(grep '^lattice' <<<"$info")"
-read -r rows cols <<<"${shape:-1 $n_blocks}"
-[ "$((rows * cols))" -eq "$n_blocks" ] || bk_fail 1 "$file: a $rows x $cols lattice of $n_blocks blocks"
+plot_file_shape "$file"
+[ -n "$n_blocks" ] || bk_fail 1 "$file: bksim info gives no n_blocks"
 
 # A rupture's slip is exact from /rupture_blocks: each of its blocks' x at its last stop
 # minus x at its first onset in the rupture.
@@ -230,6 +220,40 @@ out="$outdir/$out_name.$format"
 # Drawn to a hidden file beside the figure, renamed when gnuplot succeeded.
 partial=$(mktemp "$outdir/.$out_name.XXXXXX") ||
     bk_fail 1 "$outdir: cannot write there"
+if [ "$rows" -eq 1 ]; then
+    # A chain: slip against block, a bar each (a one-row colour map stretched across the frame
+    # showed the same numbers less readably); the bounding box shaded, the epicentre marked.
+    awk 'NF == 3 { b = int($1 + 0.5); if (!(b in seen)) { seen[b] = 1; print b, $3 } }' "$tmp/slip.dat" |
+        sort -n > "$tmp/chain.dat"
+    shade=""
+    if [ "$n_pieces" -gt 0 ]; then
+        k=0
+        while read -r c0 c1; do
+            k=$((k + 1))
+            shade+="set object $k rect from $c0 - 0.5, graph 0 to $c1 + 0.5, graph 1 back fs solid 0.12 noborder fc rgb '#1f77b4'
+"
+        done < <(span "$left" "$right" "$cols")
+    fi
+    gnuplot <<GP 2> "$tmp/gp.err" || bk_fail 1 "gnuplot failed drawing $out: $(cat "$tmp/gp.err")"
+set encoding utf8
+set terminal $terminal
+set output '$(bk_gp_quote "$partial")'
+set title '$(bk_gp_quote "$title1")' . "\n" . '$(bk_gp_quote "$title2")'
+set xrange [-0.5 : $cols - 0.5]
+$(tics "$cols" x)
+set xlabel 'block'
+set ylabel 'slip during the $row_word [m]'
+set grid ytics lc rgb '#c0c0c0' dt 3
+set key outside below center horizontal
+set style fill solid 0.8 noborder
+set boxwidth 0.8
+$shade
+plot '$tmp/chain.dat' using 1:2 with boxes lc rgb '#cc4c02' title 'slip', \
+     ${box_plot:+NaN with boxes fs solid 0.12 lc rgb '#1f77b4' title '$(bk_gp_quote "${box_title:-}")', }'-' using 1:2 with points pt 7 ps 1.6 lc rgb '#17becf' title 'epicentre, block $first_block'
+$epi_c 0
+e
+GP
+else
 gnuplot <<GP 2> "$tmp/gp.err" || bk_fail 1 "gnuplot failed drawing $out: $(cat "$tmp/gp.err")"
 set encoding utf8
 set terminal $terminal
@@ -258,6 +282,7 @@ e
 $epi_c $epi_r
 e
 GP
+fi
 # mktemp made it private; give it the mode a new file would have.
 chmod "$(printf %o $((0666 & ~0$(umask))))" "$partial" || true
 mv -f "$partial" "$out" || bk_fail 1 "cannot rename $partial to $out"

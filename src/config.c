@@ -6,6 +6,7 @@
  * bottom. */
 #include <ctype.h>
 #include <errno.h>
+#include <math.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,6 +16,7 @@
 #include <ini.h>
 
 #include "config_loader.h"
+#include "layout.h"
 
 #define MAX_FILE_BYTES (1 << 20)
 
@@ -196,4 +198,17 @@ int bk_config_load_file(const char *path, const char *const *overrides, size_t n
     }
     free(text);
     return rc;
+}
+
+void bk_config_output_estimate(const bk_config *config, double *rows, double *row_bytes, double *per_second,
+                               double *transition_bytes)
+{
+    *transition_bytes = config->output.transitions ? BK_TRANSITION_RECORD_BYTES : 0.0;
+    const bk_model *m = config->model;
+    double interval = config->output.interval;
+    *row_bytes = m ? bk_output_row_bytes(config->output.fields, m->n_blocks, m->n_friction_state,
+                                         bk_model_is_damped(m))
+                   : 0.0;
+    *rows = interval > 0.0 ? floor(config->t_end / interval) + 2.0 : 2.0;
+    *per_second = interval > 0.0 ? *row_bytes / interval : 0.0;
 }

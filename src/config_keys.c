@@ -169,9 +169,10 @@ static const key_def keys[] = {
                 "anyway); auto: true up to 16 blocks"},
      BK_KEY_BOOLEAN, NULL, NULL, "auto"},
     NUM("output", "max_bytes", "B", 1e10, 0.0, INFINITY, BK_PARAM_MIN_EXCLUSIVE,
-        "largest size the output may take: the sample rows (t_end / interval, times the bytes per row for "
-        "the fields and blocks) are checked at load, against a typo in interval or n_blocks; event rows and "
-        "transitions as they are written, and the run stops with an error there"),
+        "largest size the output file may take on disk: the sample rows (t_end / interval, times the bytes "
+        "per row for the fields and blocks) are checked at load, against a typo in interval or n_blocks; "
+        "the file itself (event rows, transitions, catalogs, chunks and HDF5's metadata) before every write, "
+        "and the run stops with an error there, its .part closed cleanly"),
     INT("output", "max_rows", 1e8, 1, 1e15, 0,
         "largest number of sample rows (t_end / interval) a run may write: a guard against a typo in interval"),
     {"output", {"checkpoint_interval", "s", NAN, 0.0, INFINITY, BK_PARAM_DERIVED,

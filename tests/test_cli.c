@@ -539,6 +539,48 @@ static void test_never_replaces_others_files(void **state)
     free(config_text);
 }
 
+static long file_size(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 ? (long)st.st_size : -1;
+}
+
+/* Sizes that mean what they say: a run of two sample rows of 100 blocks makes a file of its
+ * size (chunks sized to the run: it was 5.4 MB of 1 MiB chunks for 0.3 MB of content), a
+ * file never passes [output] max_bytes (chunks and HDF5's metadata included; the run stops
+ * with the key named), and `bksim check` says what the sample rows will weigh. */
+static void test_sizes_mean_what_they_say(void **state)
+{
+    (void)state;
+    const char *scene = "configs/chains/random_strength_100.ini --quiet --set output.interval=10 --set run.t_end=10";
+    char out[512], cmd[2048], part[600];
+    snprintf(out, sizeof out, "%s/small.h5", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s", scene, out);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    long whole = file_size(out);
+    print_message("2 rows of 100 blocks with their catalog: %ld bytes\n", whole);
+    assert_true(whole > 0 && whole < 400000);
+    static const double bounds[] = {1e5, 2e5};
+    for (size_t k = 0; k < 2; ++k) {
+        snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --set output.max_bytes=%g", scene, out, bounds[k]);
+        expect_command(cmd, 1, "[output] max_bytes = ");
+        snprintf(part, sizeof part, "%s.part", out);
+        long size = file_size(part);
+        print_message("max_bytes = %g: the .part holds %ld bytes\n", bounds[k], size);
+        assert_true(size > 0 && (double)size <= bounds[k]);
+        bk_error err = {0};
+        assert_int_equal(bk_h5_verify(part, &err), BK_INCOMPLETE);
+        remove(part);
+    }
+    /* The look ahead counts whole chunks, some twice while HDF5's chunk cache holds them: a
+     * bound a quarter above the whole file lets the run finish. */
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s --set output.max_bytes=%ld", scene, out, whole + whole / 4);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    expect_command("./bksim check configs/paper/case_a_coulomb.ini", 0,
+                   "case_a_coulomb.ini: output: about 4.1e+06 B of sample rows (50002 rows of 82 B, 8.2e+05 B per "
+                   "simulated second), plus 38 B per transition");
+}
+
 /* README's config reference is exactly what `bksim keys` prints. */
 static void test_readme_reference_current(void **state)
 {
@@ -576,6 +618,7 @@ int main(void)
         cmocka_unit_test(test_info_at_chain_scale),
         cmocka_unit_test(test_damaged_files),
         cmocka_unit_test(test_never_replaces_others_files),
+        cmocka_unit_test(test_sizes_mean_what_they_say),
         cmocka_unit_test(test_readme_reference_current),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);

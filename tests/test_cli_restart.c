@@ -400,6 +400,46 @@ static void test_sigterm_keeps_the_work(void **state)
     free(text);
 }
 
+/* A full disk, stood in for by a file-size limit (ulimit -f) at three sizes: the run stops
+ * before a write would meet it, says so (exit 1), and leaves a .part that `bksim info` reads
+ * with its last checkpoint; --restart (with room again) ends with the very output of an
+ * uninterrupted run.  Without the writer's look ahead, the first write past the limit
+ * killed the run (SIGXFSZ) and left a .part of no rows and no checkpoint. */
+static void test_file_size_limit(void **state)
+{
+    (void)state;
+    const char *scene = "configs/chains/bk10_coulomb.ini --quiet --set run.t_end=30 --set output.checkpoint_work=2e4 "
+                        "--set output.checkpoint_wall_interval=0";
+    char reference[512], out[512], cmd[2048], *text = NULL;
+    snprintf(reference, sizeof reference, "%s/limit_reference.h5", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run %s -o %s", scene, reference);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    static const long limits[] = {8000000, 14000000, 20000000}; /* bytes; the whole output is 23 MB */
+    for (size_t k = 0; k < 3; ++k) {
+        snprintf(out, sizeof out, "%s/limited_%zu.h5", tmpdir, k);
+        /* prlimit, not the shell's ulimit -f: its unit is 512 bytes in sh, 1024 in bash. */
+        snprintf(cmd, sizeof cmd, "prlimit --fsize=%ld ./bksim run %s -o %s", limits[k], scene, out);
+        int status = run_command(cmd, &text);
+        if (status != 1 || !strstr(text, "continue it from its checkpoint t = "))
+            print_error("file-size limit %ld: exit %d: %s\n", limits[k], status, text);
+        assert_int_equal(status, 1);
+        assert_non_null(strstr(text, ".part: no room for the next "));
+        assert_non_null(strstr(text, "within the file-size limit (ulimit -f)"));
+        assert_non_null(strstr(text, "continue it from its checkpoint t = "));
+        free(text);
+        snprintf(cmd, sizeof cmd, "./bksim info %s.part", out);
+        assert_int_equal(run_command(cmd, &text), 3);
+        const char *at = strstr(text, "checkpoint   t = ");
+        assert_non_null(at);
+        print_message("file-size limit %ld bytes: stopped with a checkpoint at t = %.6g s of 30 s\n", limits[k],
+                      strtod(at + strlen("checkpoint   t = "), NULL));
+        free(text);
+        snprintf(cmd, sizeof cmd, "./bksim run --restart %s.part --quiet", out);
+        assert_int_equal(run_command(cmd, NULL), 0);
+        assert_same_output(reference, out);
+    }
+}
+
 /* A run with the default checkpoint settings, scaled down (restart points every 2e4 units of
  * work instead of 1e7, some 45 in the run; the wall-clock interval a quarter of the run),
  * writes a checkpoint once that interval has passed; killed then and restarted, it ends with
@@ -604,6 +644,7 @@ int main(void)
         cmocka_unit_test(test_sigkill_restart_loop),
         cmocka_unit_test(test_wall_clock_checkpoint),
         cmocka_unit_test(test_sigterm_keeps_the_work),
+        cmocka_unit_test(test_file_size_limit),
         cmocka_unit_test(test_restart_errors),
         cmocka_unit_test(test_resume_sets_damaged_aside),
     };

@@ -188,11 +188,13 @@ static void test_figures_and_columns(void **state)
     H5Tinsert(mem, "mean_recurrence", sizeof(double), H5T_NATIVE_DOUBLE);
     double rows[3][2];
     assert_true(H5Dread(dset, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows) >= 0);
+    /* In the grid's order: mu_2 (mu_d = 0.1 too) sorts after mu_0, which sets no
+     * output.events, and before mu_1 (0.3). */
     for (int k = 0; k < 2; ++k) {
         double period, peak;
         closed_form(mu_d[k], &period, &peak);
-        assert_close(rows[k][0], mu_d[k], 0.0, 0.0);
-        assert_close(rows[k][1], period, 0.0, 1e-12 * period);
+        assert_close(rows[2 * k][0], mu_d[k], 0.0, 0.0);
+        assert_close(rows[2 * k][1], period, 0.0, 1e-12 * period);
     }
     H5Tclose(mem);
     H5Dclose(dset);
@@ -265,10 +267,16 @@ static void test_catalog_table(void **state)
     snprintf(cmd, sizeof cmd, "./bksim run configs/chains/carlson_langer_100.ini -q -o %s --set run.t_end=150 "
              "&& cp %s %s", ring, ring, old);
     assert_int_equal(run_command(cmd, NULL), 0);
+    /* As a file from before the rupture catalog: none of its tables, none in the list of
+     * datasets written (a file that lists a table it lacks is damaged, and left out). */
     hid_t file = H5Fopen(old, H5F_ACC_RDWR, H5P_DEFAULT);
     assert_true(file >= 0);
     assert_true(H5Ldelete(file, "ruptures", H5P_DEFAULT) >= 0);
+    assert_true(H5Ldelete(file, "rupture_blocks", H5P_DEFAULT) >= 0);
+    assert_true(H5Ldelete(file, "rupture_rate", H5P_DEFAULT) >= 0);
+    assert_true(H5Adelete(file, "datasets") >= 0);
     H5Fclose(file);
+    assert_int_equal(bk_h5_verify(old, &(bk_error){0}), BK_OK);
 
     bk_error err = {0};
     bk_rupture *ruptures = NULL;
@@ -380,12 +388,55 @@ static void test_nothing_to_summarise(void **state)
     expect_command(cmd, 2, "--from needs a time");
 }
 
+/* Rows in the grid's order (1e-3 m/s after 5e-4: file names would put it first), and a
+ * finished file whose dataset was cut short left out and named instead of summarised. */
+static void test_grid_order_and_damage(void **state)
+{
+    (void)state;
+    char dir[512], cmd[2048];
+    snprintf(dir, sizeof dir, "%s/grid", tmpdir);
+    const char *values[] = {"1e-3", "5e-4", "2e-3"};
+    for (size_t k = 0; k < 3; ++k) {
+        snprintf(cmd, sizeof cmd, "./bksim run configs/paper/case_a_coulomb.ini -q -o %s/driver.velocity=%s.h5 "
+                 "--set driver.velocity=%s --set run.t_end=1", dir, values[k], values[k]);
+        assert_int_equal(run_command(cmd, NULL), 0);
+    }
+    snprintf(cmd, sizeof cmd, "cp %s/driver.velocity=1e-3.h5 %s/damaged.h5", dir, dir);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    char damaged[600];
+    snprintf(damaged, sizeof damaged, "%s/damaged.h5", dir);
+    hid_t file = H5Fopen(damaged, H5F_ACC_RDWR, H5P_DEFAULT);
+    hid_t v = H5Dopen2(file, "v", H5P_DEFAULT);
+    hsize_t dims[2] = {100, 1};
+    assert_true(H5Dset_extent(v, dims) >= 0);
+    H5Dclose(v);
+    H5Fclose(file);
+    bk_stats_options opt;
+    bk_stats_options_default(&opt);
+    bk_error err = {0};
+    char *notes_text = NULL;
+    size_t notes_len = 0, n_runs = 0;
+    FILE *notes = open_memstream(&notes_text, &notes_len);
+    assert_int_equal(bk_h5_summary(dir, NULL, &opt, notes, &n_runs, &err), BK_OK);
+    fclose(notes);
+    assert_int_equal(n_runs, 3);
+    assert_non_null(strstr(notes_text, "left out "));
+    assert_non_null(strstr(notes_text, "damaged.h5: damaged: /v has 100 rows"));
+    free(notes_text);
+    snprintf(cmd, sizeof cmd, "awk -F'\\t' '!/^#/ && NR > 2 {print $1}' %s/summary.tsv | tr '\\n' ' '", dir);
+    char *order = NULL;
+    assert_int_equal(run_command(cmd, &order), 0);
+    assert_string_equal(order, "driver.velocity=5e-4.h5 driver.velocity=1e-3.h5 driver.velocity=2e-3.h5 ");
+    free(order);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_figures_and_columns),
         cmocka_unit_test(test_catalog_table),
         cmocka_unit_test(test_nothing_to_summarise),
+        cmocka_unit_test(test_grid_order_and_damage),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -64,6 +64,21 @@ static void test_summary_script(void **state)
     assert_non_null(strstr(text, "no_cof "));
     assert_non_null(strstr(text, "apparent COF n/a"));
     free(text);
+
+    /* A run without sample rows (interval = 0: rows only at t = 0, t_end and its transition
+     * instants) has no slip's peak in it: no figure rather than a low one, and the kinematics
+     * plot refuses instead of drawing lines through slips that did not happen. */
+    char no_rows[512];
+    snprintf(no_rows, sizeof no_rows, "%s/no_rows.h5", tmpdir);
+    snprintf(cmd, sizeof cmd, "./bksim run configs/chains/bk10_coulomb.ini -q -o %s --set output.interval=0 "
+             "--set run.t_end=5", no_rows);
+    assert_int_equal(run_command(cmd, NULL), 0);
+    snprintf(cmd, sizeof cmd, "BKSIM=./bksim scripts/summary.sh %s", no_rows);
+    expect_command(cmd, 0, "peak slip rate n/a (no sample rows: [output] interval = 0)");
+    snprintf(cmd, sizeof cmd, "BKSIM=./bksim scripts/plot_kinematics.sh %s/k.png t %s:run:blue", tmpdir, no_rows);
+    expect_command(cmd, 1, "has no sample rows between t = 0 and its end ([output] interval = 0)");
+    snprintf(cmd, sizeof cmd, "%s/k.png", tmpdir);
+    assert_false(path_exists(cmd));
 }
 
 /* The paper's plot scripts: any block, png/pdf/svg, and a clear refusal of bad options. */
@@ -182,6 +197,21 @@ static void test_catalog_scripts(void **state)
     assert_non_null(strstr(text, "/fig/sheet_rupture_"));
     assert_non_null(strstr(text, "_slip_map.png"));
     free(text);
+    /* On a chain, slip against block (bars), not a one-row colour map stretched over the frame. */
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh --format svg -o %s/fig %s > /dev/null && "
+             "grep -c -e '>block<' -e '>slip during the rupture \\[m\\]<' %s/fig/ends_rupture_*_slip_map.svg",
+             bin, tmpdir, out, tmpdir);
+    assert_int_equal(run_command(cmd, &text), 0);
+    assert_string_equal(text, "2\n");
+    free(text);
+    /* plot_mfd.sh on the lattice: its MFD, and no space-time plot of flat block indices
+     * (left..right bound a box on a lattice), said on stderr. */
+    snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_mfd.sh -o %s/fig %s/sheet.h5", bin, tmpdir, tmpdir);
+    expect_command(cmd, 0, "a 4 x 5 lattice: no space-time plot (left..right are the flat block indices");
+    snprintf(cmd, sizeof cmd, "%s/fig/sheet_ruptures_spacetime.png", tmpdir);
+    assert_false(path_exists(cmd));
+    snprintf(cmd, sizeof cmd, "%s/fig/sheet_ruptures_mfd.png", tmpdir);
+    assert_true(path_exists(cmd));
     snprintf(cmd, sizeof cmd, "BKSIM=%s scripts/plot_slip_map.sh --format svg --event 0 -o %s/fig %s/sheet.h5", bin,
              tmpdir, tmpdir);
     assert_int_equal(run_command(cmd, NULL), 0);

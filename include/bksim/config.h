@@ -123,6 +123,13 @@ int bk_config_load_string(const char *text, const char *name, const char *const 
                           size_t n_overrides, bk_config **out, bk_error *err);
 void bk_config_free(bk_config *config);
 
+/* What a run of config writes as sample rows: *rows of *row_bytes each over t_end (the
+ * regular samples and the last), *per_second bytes per simulated second (0 with interval = 0).
+ * Transitions (*transition_bytes each), event rows and the catalogs come on top, as many as
+ * the run makes. */
+void bk_config_output_estimate(const bk_config *config, double *rows, double *row_bytes, double *per_second,
+                               double *transition_bytes);
+
 /* Values that pass every range check but are far outside what the other values make
  * plausible (src/config_warnings.c): a driver faster than the blocks' own slip speeds, a
  * sampling interval longer than a slip, a max_step longer than the fastest natural period.

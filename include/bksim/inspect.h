@@ -100,8 +100,9 @@ int bk_h5_read_event_table(const char *path, const char *table, bk_event_table *
 int bk_stats_report_read(const char *path, const char *table, const bk_stats_options *opt,
                          bk_stats_report **out, bk_error *err);
 
-/* `bksim summary DIR [--table NAME]`: one row per finished run (complete *.h5) in dir,
- * sorted by file name: file, point (the sweep's grid point), one column per --set key any
+/* `bksim summary DIR [--table NAME]`: one row per finished run (complete *.h5, every dataset
+ * verifying) in dir, in the grid's order (by the --set keys in the order the runs give them,
+ * numbers as numbers, then by file name): file, point (the sweep's grid point), one column per --set key any
  * run used (named by the key, holding that run's value), then its headline figures from its
  * catalog table (table as for bk_h5_read_event_table: NULL for /ruptures, else /events):
  * events (the table's complete rows, ruptures by default, starting in [opt->t_from,

@@ -150,6 +150,10 @@ static void catch_stop_signals(void)
     const int signals[] = {SIGINT, SIGTERM, SIGHUP, SIGXCPU};
     for (size_t k = 0; k < sizeof signals / sizeof signals[0]; ++k)
         sigaction(signals[k], &action, NULL);
+    /* Past the file-size limit (ulimit -f) a write fails with EFBIG instead of killing the
+     * process: the writer stops before that (h5_room.c), and a write that still meets it
+     * leaves the .part to be closed and reported like any other failed write. */
+    signal(SIGXFSZ, SIG_IGN);
 }
 
 /* Options shared by run and check. */
@@ -299,6 +303,15 @@ static int cmd_check(int argc, char **argv)
                args.config_path, m->n_blocks, m->n_blocks == 1 ? "" : "s", shape,
                m->spring == BK_SPRING_LINEAR ? "linear" : "tension-only", driver,
                config->t_end, config->solver.method, config->output.path);
+        /* What the output will weigh, before a long run fills a disk. */
+        double rows = 0.0, row_bytes = 0.0, per_second = 0.0, transition_bytes = 0.0;
+        bk_config_output_estimate(config, &rows, &row_bytes, &per_second, &transition_bytes);
+        char rate[96] = "";
+        if (per_second > 0.0)
+            snprintf(rate, sizeof rate, ", %.3g B per simulated second", per_second);
+        printf("%s: output: about %.3g B of sample rows (%.0f rows of %.0f B%s), plus %.0f B per transition and "
+               "the catalog's rows, as many as the run makes; [output] max_bytes = %.3g B bounds the file\n",
+               args.config_path, rows * row_bytes, rows, row_bytes, rate, transition_bytes, config->output.max_bytes);
     }
     bk_config_free(config);
     free(args.overrides);

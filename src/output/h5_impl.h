@@ -80,6 +80,7 @@ typedef struct bk_h5_table {
     size_t capacity;     /* records the buffer holds */
     size_t buffered;
     hsize_t written;     /* records appended to the dataset */
+    hsize_t committed;   /* records in the last commit */
     unsigned char *buf;
 } bk_h5_table;
 
@@ -90,7 +91,10 @@ struct bk_h5_writer {
     size_t n_blocks;
     bk_h5_series s[BK_N_SERIES];
     size_t buffer_rows;  /* rows of a 2-D chunk */
+    double expected_rows; /* of the run, for its chunks: small runs get small files */
+    double max_bytes;    /* [output] max_bytes: the file on disk stays within it (+inf: no bound) */
     hsize_t rows;        /* rows accepted; every series holds them, on disk or buffered */
+    hsize_t committed_rows; /* rows in the last commit */
     double t_buffered;   /* time of the last row accepted */
     double t_written;    /* time of the last row in the last commit */
     bk_h5_table tables[BK_N_TABLES]; /* dset invalid for a table the run does not write */
@@ -102,16 +106,26 @@ struct bk_h5_writer {
     long long cp_sequence; /* of the last checkpoint written (0: none) */
     int cp_slot;         /* slot of /checkpoint the next checkpoint goes to */
     int failed;          /* a write failed: rows on disk may be ragged, accept no more */
+    int out_of_room;     /* failed because bk_h5_writer_room said no: every write so far succeeded */
+    double unflushed;    /* chunk bytes appended since the last flush: HDF5's chunk cache may hold
+                            them, not yet allocated in the file */
 };
+
+/* Whether bytes more (and HDF5's metadata) fit on the .part's disk and under the file-size
+ * limit: BK_OK, or BK_ERR_IO saying which and marking the writer failed and out of room
+ * (h5_room.c). */
+int bk_h5_writer_room(bk_h5_writer *w, double bytes, bk_error *err);
 
 /* The one set-up shared by a new run (bk_h5_writer_open) and a resumed one
  * (bk_h5_writer_resume): a writer for the final name path, its .part name, every id
  * invalid.  BK_ERR_NOMEM on failure (message names path). */
 int bk_h5_writer_new(bk_h5_writer **out, const char *path, bk_error *err);
-/* Size the row buffers for this chain: how many rows a buffer holds. */
-void bk_h5_writer_size(bk_h5_writer *w, const bk_model *model);
-/* Shape series i for this chain and allocate its row buffer; -1 when out of memory. */
-int bk_h5_writer_series(bk_h5_writer *w, int i, const bk_model *model);
+/* Size the row buffers for this chain and a run of about expected_rows rows: how many rows a
+ * buffer (and a chunk of a new dataset) holds. */
+void bk_h5_writer_size(bk_h5_writer *w, const bk_model *model, double expected_rows);
+/* Shape series i for this chain and allocate its row buffer of chunk_rows rows (0: as
+ * bk_h5_writer_size decided, for a new dataset); -1 when out of memory. */
+int bk_h5_writer_series(bk_h5_writer *w, int i, const bk_model *model, size_t chunk_rows);
 /* The buffer and memory types of a table; -1 on failure. */
 int bk_h5_writer_table(bk_h5_table *table, bk_h5_table_kind kind);
 /* Close every id the writer holds; -1 if any close failed. */

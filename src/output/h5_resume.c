@@ -5,6 +5,7 @@
 #include "bksim/output.h"
 
 #include <stdlib.h>
+#include <math.h>
 #include <string.h>
 #include <sys/stat.h>
 
@@ -130,14 +131,21 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
     }
     if (rc == BK_OK) {
         const bk_model *model = config->model;
-        bk_h5_writer_size(w, model);
+        bk_h5_writer_size(w, model, 0.0);
+        w->max_bytes = config->output.max_bytes > 0.0 ? config->output.max_bytes : INFINITY;
         hsize_t rows = (hsize_t)rec->rows;
         for (int i = 0; rc == BK_OK && i < BK_N_SERIES; ++i) {
             bk_h5_series *ser = &w->s[i];
             if (H5Lexists(w->file, bk_series[i].name, H5P_DEFAULT) <= 0)
                 continue;
             ser->dset = H5Dopen2(w->file, bk_series[i].name, H5P_DEFAULT);
-            if (ser->dset < 0 || bk_h5_writer_series(w, i, model) < 0 ||
+            /* Buffers of the dataset's own chunk rows (chosen for the run it began as). */
+            hsize_t chunk[2] = {0, 0};
+            hid_t dcpl = ser->dset >= 0 ? H5Dget_create_plist(ser->dset) : H5I_INVALID_HID;
+            if (dcpl < 0 || H5Pget_chunk(dcpl, 2, chunk) < 1)
+                chunk[0] = 0;
+            CLOSE_IDS(0, dcpl);
+            if (ser->dset < 0 || bk_h5_writer_series(w, i, model, (size_t)chunk[0]) < 0 ||
                 truncate_rows(ser->dset, rows, bk_h5_kind_mem_type(bk_series[i].kind), ser->cols * ser->elem) < 0)
                 rc = H5_FAIL(err, "%s: cannot reopen /%s at the checkpoint's %llu rows", w->part,
                              bk_series[i].name, (unsigned long long)rows);
@@ -179,9 +187,9 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
             if (buffered < 0 || t->dset < 0 ||
                 truncate_rows(t->dset, (hsize_t)counts[k], t->mem, bk_h5_tables[k].struct_bytes) < 0)
                 rc = H5_FAIL(err, "%s: cannot reopen /%s at the checkpoint", w->part, name);
-            t->written = (hsize_t)counts[k];
+            t->written = t->committed = (hsize_t)counts[k];
         }
-        w->rows = rows;
+        w->rows = w->committed_rows = rows;
         w->trans_last_t = rec->last_transition_t;
         w->t_written = w->t_buffered = cp->t_last_row;
         /* The next checkpoint goes into the other slot: this one stays the fallback. */

@@ -278,6 +278,12 @@ static int read_run(summary *s, const char *dir, const char *name, const char *t
     }
     if (rc == BK_OK && numeric_attr(file, "complete") != 1.0)
         rc = BK_FAIL(err, BK_INCOMPLETE, "%s: the run did not finish (complete = 0)", path);
+    /* A finished file whose datasets are damaged would put wrong figures in the table. */
+    if (rc == BK_OK) {
+        bk_error why = {0};
+        if (bk_h5_verify(path, &why) == BK_ERR_DAMAGED)
+            rc = BK_FAIL(err, BK_ERR_DAMAGED, "%s", why.message);
+    }
     if (rc == BK_OK) {
         run.point = bk_h5_read_string_attr(file, "point");
         run.host = bk_h5_read_string_attr(file, "host");
@@ -535,9 +541,36 @@ static int write_table(const summary *s, column *cols, size_t n_cols, const char
     return rc;
 }
 
-static int by_file_name(const void *a, const void *b)
+/* The keys the rows are ordered by (qsort has no context argument). */
+static size_t order_keys;
+
+/* A key's value as a number, when the whole of it is one. */
+static int as_number(const char *text, double *x)
 {
-    return strcmp(((const run_row *)a)->file, ((const run_row *)b)->file);
+    char *end = NULL;
+    *x = text ? strtod(text, &end) : NAN;
+    return text && end != text && *end == '\0';
+}
+
+/* The grid's order: by the swept keys in the order the runs give them (the first slowest),
+ * numbers as numbers (1e-3 before 0.5, as the sweep lists them; file names sort them the
+ * other way), then by file name. */
+static int by_grid(const void *pa, const void *pb)
+{
+    const run_row *a = pa, *b = pb;
+    for (size_t k = 0; k < order_keys; ++k) {
+        const char *va = k < a->n_values ? a->values[k] : NULL, *vb = k < b->n_values ? b->values[k] : NULL;
+        if (!va || !vb) {
+            if (va != vb)
+                return va ? 1 : -1;
+            continue;
+        }
+        double x, y;
+        int c = as_number(va, &x) && as_number(vb, &y) ? (x > y) - (x < y) : strcmp(va, vb);
+        if (c != 0)
+            return c;
+    }
+    return strcmp(a->file, b->file);
 }
 
 static int is_run_output(const char *name)
@@ -618,7 +651,8 @@ int bk_h5_summary(const char *dir, const char *table, const bk_stats_options *op
     size_t n_cols = 0;
     column *cols = NULL;
     if (rc == BK_OK) {
-        qsort(s.runs, s.n_runs, sizeof *s.runs, by_file_name);
+        order_keys = s.n_keys;
+        qsort(s.runs, s.n_runs, sizeof *s.runs, by_grid);
         cols = make_columns(&s, &n_cols);
         if (!cols)
             rc = BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", dir);

@@ -5,6 +5,7 @@
 #include "bksim/output.h"
 
 #include <fcntl.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -183,13 +184,16 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
     if (stored < 0)
         return H5_FAIL(err, "%s: cannot write root attributes", w->part);
 
-    bk_h5_writer_size(w, model);
+    w->max_bytes = config->output.max_bytes > 0.0 ? config->output.max_bytes : INFINITY;
+    /* Sample rows, and the first and last; event rows cannot be foreseen. */
+    double interval = config->output.interval;
+    bk_h5_writer_size(w, model, interval > 0.0 ? floor(config->t_end / interval) + 2.0 : 2.0);
     for (int i = 0; i < BK_N_SERIES; ++i) {
         const bk_series_def *def = &bk_series[i];
         bk_h5_series *s = &w->s[i];
         if (!bk_series_selected(def, fields, n_state, bk_model_is_damped(model)))
             continue;
-        if (bk_h5_writer_series(w, i, model) < 0)
+        if (bk_h5_writer_series(w, i, model, 0) < 0)
             return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory for the /%s buffer", w->part,
                            def->name);
         s->dset = create_extendable(w->file, def->name, bk_h5_kind_file_type(def->kind), s->rank,
@@ -289,6 +293,7 @@ int bk_h5_writer_new(bk_h5_writer **out, const char *path, bk_error *err)
         return BK_FAIL(err, BK_ERR_NOMEM, "%s: out of memory", path);
     w->file = H5I_INVALID_HID;
     w->part_fd = -1;
+    w->max_bytes = INFINITY;
     for (int k = 0; k < BK_N_TABLES; ++k)
         w->tables[k].dset = w->tables[k].mem = w->tables[k].packed = H5I_INVALID_HID;
     for (int i = 0; i < BK_N_SERIES; ++i)
@@ -304,23 +309,32 @@ int bk_h5_writer_new(bk_h5_writer **out, const char *path, bk_error *err)
     return BK_OK;
 }
 
-void bk_h5_writer_size(bk_h5_writer *w, const bk_model *model)
+void bk_h5_writer_size(bk_h5_writer *w, const bk_model *model, double expected_rows)
 {
     size_t n_state = model->n_friction_state;
     size_t widest = model->n_blocks > n_state ? model->n_blocks : n_state;
     size_t rows = CHUNK_BYTES / (widest * sizeof(double));
     w->n_blocks = model->n_blocks;
     w->buffer_rows = rows < 1 ? 1 : rows > MAX_BUFFER_ROWS ? MAX_BUFFER_ROWS : rows;
+    w->expected_rows = expected_rows;
 }
 
-int bk_h5_writer_series(bk_h5_writer *w, int i, const bk_model *model)
+/* HDF5 allocates whole chunks: a chunk of a series holds the run's expected rows when they
+ * are fewer than a full chunk, but at least MIN_CHUNK_BYTES, so that event rows the estimate
+ * could not count do not split a long run into a multitude of tiny chunks. */
+#define MIN_CHUNK_BYTES (16u << 10)
+
+int bk_h5_writer_series(bk_h5_writer *w, int i, const bk_model *model, size_t chunk_rows)
 {
     const bk_series_def *def = &bk_series[i];
     bk_h5_series *s = &w->s[i];
     s->rank = def->shape == BK_SHAPE_T ? 1 : 2;
     s->cols = bk_series_columns(def, model->n_blocks, model->n_friction_state);
     s->elem = bk_series_value_size(def->kind);
-    s->rows = s->rank == 1 ? SERIES_1D_CHUNK : w->buffer_rows;
+    size_t full = s->rank == 1 ? SERIES_1D_CHUNK : w->buffer_rows;
+    size_t row_bytes = s->cols * s->elem, floor_rows = (MIN_CHUNK_BYTES + row_bytes - 1) / row_bytes;
+    double wanted = fmax(w->expected_rows, (double)floor_rows);
+    s->rows = chunk_rows ? chunk_rows : wanted < (double)full ? (size_t)wanted : full;
     s->buffered = 0;
     s->buf = malloc(s->rows * s->cols * s->elem);
     return s->buf ? 0 : -1;
@@ -441,6 +455,14 @@ static void appended(bk_h5_writer *w, size_t bytes)
         bk_output_write_behind(w->part_fd);
 }
 
+/* The file space count rows appended at row start take: HDF5 allocates whole chunks of
+ * chunk_rows rows, the first time a row of one is written. */
+static double chunk_bytes_added(hsize_t start, hsize_t count, size_t chunk_rows, size_t row_bytes)
+{
+    hsize_t allocated = (start + chunk_rows - 1) / chunk_rows, needed = (start + count + chunk_rows - 1) / chunk_rows;
+    return (double)(needed - allocated) * (double)chunk_rows * (double)row_bytes;
+}
+
 /* Series i's buffered rows to its dataset. */
 static int append_series(bk_h5_writer *w, int i, bk_error *err)
 {
@@ -449,6 +471,9 @@ static int append_series(bk_h5_writer *w, int i, bk_error *err)
         return BK_OK;
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
     hsize_t start = w->rows - (hsize_t)s->buffered;
+    int room = bk_h5_writer_room(w, chunk_bytes_added(start, (hsize_t)s->buffered, s->rows, s->cols * s->elem), err);
+    if (room != BK_OK)
+        return room;
     if (append(s->dset, s->rank, start, (hsize_t)s->buffered, (hsize_t)s->cols,
                bk_h5_kind_mem_type(bk_series[i].kind), s->buf) < 0) {
         w->failed = 1;
@@ -464,6 +489,9 @@ static int append_table(bk_h5_writer *w, bk_h5_table *t, const char *name, bk_er
     if (t->buffered == 0)
         return BK_OK;
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    int room = bk_h5_writer_room(w, chunk_bytes_added(t->written, (hsize_t)t->buffered, t->capacity, t->record), err);
+    if (room != BK_OK)
+        return room;
     if (append(t->dset, 1, t->written, (hsize_t)t->buffered, 1, t->packed, t->buf) < 0) {
         w->failed = 1;
         return H5_FAIL(err, "%s: cannot append to /%s", w->part, name);
@@ -497,6 +525,10 @@ int bk_h5_writer_flush(bk_h5_writer *w, bk_error *err)
     }
     w->last_commit = wall_seconds();
     w->uncounted = 0;
+    w->unflushed = 0.0;
+    w->committed_rows = w->rows;
+    for (int k = 0; k < BK_N_TABLES; ++k)
+        w->tables[k].committed = w->tables[k].written;
     return BK_OK;
 }
 
@@ -637,6 +669,10 @@ static int sink_checkpoint(void *self, const bk_checkpoint *cp, bk_error *err)
     int rc = bk_h5_writer_flush(w, err);
     if (rc != BK_OK)
         return rc;
+    /* Its arrays: a few per block, the friction states, the open events' and ruptures'. */
+    double bytes = 256.0 * (double)cp->n_blocks + 8.0 * (double)cp->n_state + 64.0 * 1024.0;
+    if ((rc = bk_h5_writer_room(w, bytes, err)) != BK_OK)
+        return rc;
     bk_checkpoint_record rec = {w->cp_sequence + 1, (long long)w->rows,
                                 (long long)w->tables[BK_TABLE_TRANSITIONS].written, w->trans_last_t};
     rc = bk_h5_write_checkpoint(w->file, w->part, w->cp_slot, cp, &rec, err);
@@ -705,6 +741,21 @@ int bk_h5_writer_finish(bk_h5_writer *writer, const bk_run_stats *stats, bk_erro
     return rc;
 }
 
+/* Every dataset back to its length at the last commit (shrinking only writes metadata). */
+static void cut_to_commit(bk_h5_writer *w)
+{
+    for (int i = 0; i < BK_N_SERIES; ++i) {
+        hsize_t dims[2] = {w->committed_rows, (hsize_t)w->s[i].cols};
+        if (w->s[i].dset >= 0)
+            H5Dset_extent(w->s[i].dset, dims);
+    }
+    for (int k = 0; k < BK_N_TABLES; ++k) {
+        hsize_t dims[1] = {w->tables[k].committed};
+        if (w->tables[k].dset >= 0)
+            H5Dset_extent(w->tables[k].dset, dims);
+    }
+}
+
 void bk_h5_writer_abandon(bk_h5_writer *writer, const char *reason, const bk_run_stats *stats)
 {
     bk_h5_writer *w = writer;
@@ -715,6 +766,10 @@ void bk_h5_writer_abandon(bk_h5_writer *writer, const char *reason, const bk_run
     /* After a failed append the datasets may be ragged; appending again would misalign. */
     if (!w->failed)
         bk_h5_writer_flush(w, &ignored);
+    /* Stopped for room, every write succeeded but the datasets stand where each last
+     * appended: back to the last commit, as a reader and a restart expect them. */
+    if (w->out_of_room)
+        cut_to_commit(w);
     if (stats)
         bk_h5_write_stats(w->file, stats);
     bk_h5_write_int_attr(w->file, "complete", 0);
