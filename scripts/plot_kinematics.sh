@@ -17,7 +17,7 @@ for spec in "$@"; do
     IFS=: read -r file label color <<<"$spec"
     # A line through rows at transitions only would draw slips that never happened.
     if [ "$(bk_sample_rows "$file")" -le 2 ]; then
-        bk_fail 1 "$file has no sample rows between t = 0 and its end ([output] interval = 0): block" \
+        bk_fail 1 "$file has no sample rows between t = 0 and its end (as with [output] interval = 0): block" \
                 "$PLOT_BLOCK's x(t) and v(t) between its transitions are not in it, and a line through" \
                 "the rows it has would draw slips that did not happen; run it with [output] interval > 0" \
                 "(bksim check says what the rows weigh), or list the transitions with" \

@@ -109,12 +109,13 @@ plot_draw() {
 }
 
 # plot_file_shape FILE: the chain's length and the lattice's shape from bksim info (its exit
-# status says whether the run finished, which does not matter here): sets n_blocks (empty when
+# status says whether the run finished, which does not matter here): sets info (what bksim
+# info printed, for the caller's own questions), n_blocks (empty when
 # info gives none: another program's catalog), rows and cols ("lattice R x C blocks ...", or no
 # such line for a chain, one row).  A lattice line that does not read so is an error, never a
 # chain drawn in its place.
 plot_file_shape() {
-    local info shape
+    local shape
     info=$({ "$bksim" info "$1" 2>/dev/null || true; })
     n_blocks=$(awk '$1 == "n_blocks" {print $2; exit}' <<<"$info")
     [[ ${n_blocks:-} =~ ^[0-9]+$ ]] || { n_blocks="" rows=1 cols=""; return 0; }

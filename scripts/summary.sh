@@ -29,7 +29,7 @@ for file in "$@"; do
         awk '!/^#/ && $3 == 0 && $4 != 0 {n++} END {print n+0}') || slips=n/a
     vmax=$("$bksim" export "$file" --datasets v 2> /dev/null | columns 1) || vmax=n/a
     # Rows only at transition instants miss every slip's peak: no figure rather than a low one.
-    [ "$(bk_sample_rows "$file")" -gt 2 ] || vmax="n/a (no sample rows: [output] interval = 0)"
+    [ "$(bk_sample_rows "$file")" -gt 2 ] || vmax="n/a (no sample rows between t = 0 and the end)"
     cof=$("$bksim" export "$file" --datasets cof 2> /dev/null | columns 0) || cof=n/a
     unit=" m/s"; case $vmax in n/a*) unit="" ;; esac
     printf "%-32s slip events %4s   peak slip rate %s%s   apparent COF %s\n" "$name" "$slips" "${vmax:-n/a}" "$unit" \

@@ -190,9 +190,9 @@ char *bk_config_read_line(char *str, int num, void *stream)
         char where[300];
         snprintf(where, sizeof where, "%s:%d", ld->name, ld->line);
         bk_config_report(ld, ld->line, BK_ERR_CONFIG,
-                         "%s: a section header or key of %zu characters (allowed: at most %d; only values may be "
-                         "longer)",
-                         where, used, num - 8);
+                         "%s: a line of %zu characters that is no \"key = value\" with a key of at most %d "
+                         "characters (allowed: only values may be longer than a line of %d)",
+                         where, used, num - 8, num - 2);
         snprintf(str, (size_t)num, "\n");
     }
     return str;

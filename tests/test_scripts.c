@@ -74,9 +74,9 @@ static void test_summary_script(void **state)
              "--set run.t_end=5", no_rows);
     assert_int_equal(run_command(cmd, NULL), 0);
     snprintf(cmd, sizeof cmd, "BKSIM=./bksim scripts/summary.sh %s", no_rows);
-    expect_command(cmd, 0, "peak slip rate n/a (no sample rows: [output] interval = 0)");
+    expect_command(cmd, 0, "peak slip rate n/a (no sample rows between t = 0 and the end)");
     snprintf(cmd, sizeof cmd, "BKSIM=./bksim scripts/plot_kinematics.sh %s/k.png t %s:run:blue", tmpdir, no_rows);
-    expect_command(cmd, 1, "has no sample rows between t = 0 and its end ([output] interval = 0)");
+    expect_command(cmd, 1, "has no sample rows between t = 0 and its end (as with [output] interval = 0)");
     snprintf(cmd, sizeof cmd, "%s/k.png", tmpdir);
     assert_false(path_exists(cmd));
 }

@@ -122,6 +122,7 @@ static const char *const keys_help =
     "Prints every config key (section, unit, default, allowed range, meaning) as Markdown.\n";
 
 static volatile sig_atomic_t stop_requested = 0;
+static volatile sig_atomic_t stop_requested_at = 0; /* s on the monotonic clock, at the first signal */
 
 /* A repeated SIGXCPU is the kernel's reminder once a second past the soft CPU limit, not
  * a second request: only SIGINT, SIGTERM and SIGHUP escalate. */
@@ -132,6 +133,9 @@ static void on_signal(int signo)
         raise(signo);
         return;
     }
+    struct timespec ts; /* clock_gettime is async-signal-safe too */
+    if (!stop_requested && clock_gettime(CLOCK_MONOTONIC, &ts) == 0)
+        stop_requested_at = (sig_atomic_t)ts.tv_sec;
     stop_requested = 1;
 }
 
@@ -351,8 +355,10 @@ static int show_progress(void *user, const bk_progress *r)
     progress_state *p = user;
     /* SLURM's SIGTERM comes KillWait (30 s by default) before its SIGKILL: on to the next
      * restart point, which is written, so that nothing computed is lost. */
+    /* The grace counts from the signal, not from the run's next look at it. */
     if (stop_requested)
-        return BK_PROGRESS_CHECKPOINT_AND_STOP;
+        return now_seconds() - (double)stop_requested_at > BK_STOP_GRACE ? BK_PROGRESS_STOP
+                                                                         : BK_PROGRESS_CHECKPOINT_AND_STOP;
     if (!p->enabled)
         return 0;
     double now = now_seconds();
@@ -448,6 +454,30 @@ static int extend_run(const char *path, const char *setting, int quiet, bk_error
     return rc;
 }
 
+/* After a run stopped short: how to go on from OUT.part, from its last checkpoint, or (none)
+ * only by starting over; a stop at [output] max_bytes says that a restart keeps it. */
+static void say_how_to_go_on(const bk_config *config, const char *path, int rc)
+{
+    double t_checkpoint = 0.0;
+    bk_error ignored = {0};
+    fprintf(stderr, "bksim: partial output left in %s.part (complete = 0); ", path);
+    if (rc == BK_ERR_LIMIT)
+        fprintf(stderr, "a --restart keeps the stored [output] max_bytes = %.3g B and would stop again: run it "
+                        "again with a larger one (or fewer fields, or a longer interval)\n",
+                config->output.max_bytes);
+    else if (bk_h5_restartable(path, &t_checkpoint, &ignored) == 1)
+        fprintf(stderr, "continue it from its checkpoint t = %.17g s with `bksim run --restart %s.part`\n",
+                t_checkpoint, path);
+    else if (config->output.checkpoint_interval > 0.0 || config->output.checkpoint_work > 0.0)
+        fprintf(stderr, "it holds no checkpoint, so it cannot be continued: running again starts over "
+                        "(the run writes its first at the restart point after [output] "
+                        "checkpoint_wall_interval = %g s)\n",
+                config->output.checkpoint_wall_interval);
+    else
+        fprintf(stderr, "it holds no checkpoint, so it cannot be continued: running again starts over "
+                        "([output] checkpoint_interval = 0 writes none)\n");
+}
+
 static int cmd_run(int argc, char **argv)
 {
     config_args args;
@@ -483,7 +513,12 @@ static int cmd_run(int argc, char **argv)
         return status;
     }
     if (args.restart) {
-        opened = args.n_overrides ? extend_run(args.restart, args.overrides[0], args.quiet, &err) : BK_OK;
+        /* Refused before the .part is touched: a later t_end is written into it. */
+        char *final = bk_output_final_path(args.restart);
+        opened = final ? bk_h5_output_replaceable(final, 0, &err) : BK_FAIL(&err, BK_ERR_NOMEM, "bksim: out of memory");
+        free(final);
+        if (opened == BK_OK && args.n_overrides)
+            opened = extend_run(args.restart, args.overrides[0], args.quiet, &err);
         if (opened == BK_OK)
             opened = bk_h5_writer_resume(&writer, args.restart, &config, &checkpoint, &err);
         restart_path = bk_output_final_path(args.restart);
@@ -588,24 +623,18 @@ static int cmd_run(int argc, char **argv)
     if (rc != BK_OK) {
         fprintf(stderr, "%s: %s\n", args.restart ? args.restart : args.config_path, err.message);
         bk_h5_writer_abandon(writer, err.message, &stats);
-        /* Say how to go on: from the last checkpoint, or (none) only by starting over. */
-        double t_checkpoint = 0.0;
-        bk_error ignored = {0};
-        fprintf(stderr, "bksim: partial output left in %s.part (complete = 0); ", path);
-        if (bk_h5_restartable(path, &t_checkpoint, &ignored) == 1)
-            fprintf(stderr, "continue it from its checkpoint t = %.17g s with `bksim run --restart %s.part`\n",
-                    t_checkpoint, path);
-        else if (config->output.checkpoint_interval > 0.0 || config->output.checkpoint_work > 0.0)
-            fprintf(stderr, "it holds no checkpoint, so it cannot be continued: running again starts over "
-                            "(the run writes its first at the restart point after [output] "
-                            "checkpoint_wall_interval = %g s)\n",
-                    config->output.checkpoint_wall_interval);
-        else
-            fprintf(stderr, "it holds no checkpoint, so it cannot be continued: running again starts over "
-                            "([output] checkpoint_interval = 0 writes none)\n");
+        say_how_to_go_on(config, path, rc);
         status = EXIT_RUN_FAILED;
-    } else if (bk_h5_writer_finish(writer, &stats, &err) != BK_OK) {
+    } else if ((rc = bk_h5_writer_finish(writer, &stats, &err)) != BK_OK) {
         fprintf(stderr, "%s\n", err.message);
+        struct stat st;
+        char *part = bk_output_part_path(path);
+        if (part && stat(part, &st) == 0 && rc == BK_ERR_INVALID) /* its name was taken meanwhile */
+            fprintf(stderr, "bksim: the finished run is kept in %s: move %s away, then `bksim run --restart %s` "
+                            "publishes it from its end\n", part, path, part);
+        else if (part && stat(part, &st) == 0)
+            say_how_to_go_on(config, path, rc);
+        free(part);
         status = EXIT_RUN_FAILED;
     } else if (!args.quiet) {
         printf("%s: %ld rows, %ld transitions, t = %g s, %ld steps, %ld RHS evaluations, "

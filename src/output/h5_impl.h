@@ -109,6 +109,7 @@ struct bk_h5_writer {
     int out_of_room;     /* failed because bk_h5_writer_room said no: every write so far succeeded */
     double unflushed;    /* chunk bytes appended since the last flush: HDF5's chunk cache may hold
                             them, not yet allocated in the file */
+    double eoa_committed; /* the file's allocated end at the last flush */
 };
 
 /* Whether bytes more (and HDF5's metadata) fit on the .part's disk and under the file-size

@@ -190,6 +190,8 @@ int bk_h5_writer_resume(bk_h5_writer **out, const char *path, bk_config **config
             t->written = t->committed = (hsize_t)counts[k];
         }
         w->rows = w->committed_rows = rows;
+        haddr_t end = 0;
+        w->eoa_committed = H5Fget_eoa(w->file, &end) >= 0 ? (double)end : 0.0;
         w->trans_last_t = rec->last_transition_t;
         w->t_written = w->t_buffered = cp->t_last_row;
         /* The next checkpoint goes into the other slot: this one stays the fallback. */

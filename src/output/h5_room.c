@@ -33,8 +33,9 @@ int bk_h5_writer_room(bk_h5_writer *w, double bytes, bk_error *err)
     haddr_t allocated = 0;
     if (w->file < 0 || H5Fget_eoa(w->file, &allocated) < 0)
         return BK_OK; /* cannot tell: HDF5's own write reports a failure */
-    /* What the chunk cache still holds goes to the end of the file at the next flush. */
-    double eoa = (double)allocated + w->unflushed;
+    /* What the chunk cache still holds goes to the end of the file at the next flush; what
+     * it evicted since is in the allocated end already, so it is counted once. */
+    double eoa = fmax((double)allocated, w->eoa_committed + w->unflushed);
     if (eoa + bytes + SOFT_MARGIN > w->max_bytes) {
         w->failed = 1;
         w->out_of_room = 1;

@@ -544,12 +544,12 @@ static int write_table(const summary *s, column *cols, size_t n_cols, const char
 /* The keys the rows are ordered by (qsort has no context argument). */
 static size_t order_keys;
 
-/* A key's value as a number, when the whole of it is one. */
+/* A key's value as a number, when the whole of it is one (not NaN, which orders nothing). */
 static int as_number(const char *text, double *x)
 {
     char *end = NULL;
     *x = text ? strtod(text, &end) : NAN;
-    return text && end != text && *end == '\0';
+    return text && end != text && *end == '\0' && !isnan(*x);
 }
 
 /* The grid's order: by the swept keys in the order the runs give them (the first slowest),
@@ -565,8 +565,10 @@ static int by_grid(const void *pa, const void *pb)
                 return va ? 1 : -1;
             continue;
         }
+        /* A total order: numbers by value, before any text, text by its bytes. */
         double x, y;
-        int c = as_number(va, &x) && as_number(vb, &y) ? (x > y) - (x < y) : strcmp(va, vb);
+        int na = as_number(va, &x), nb = as_number(vb, &y);
+        int c = na && nb ? (x > y) - (x < y) : na != nb ? (na ? -1 : 1) : strcmp(va, vb);
         if (c != 0)
             return c;
     }

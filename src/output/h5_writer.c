@@ -235,6 +235,8 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
      * (see bk_h5_write_fixed_string_attr). */
     if (H5Fflush(w->file, H5F_SCOPE_LOCAL) < 0)
         return H5_FAIL(err, "%s: cannot flush", w->part);
+    haddr_t eoa = 0;
+    w->eoa_committed = H5Fget_eoa(w->file, &eoa) >= 0 ? (double)eoa : 0.0;
     return BK_OK;
 }
 
@@ -526,6 +528,8 @@ int bk_h5_writer_flush(bk_h5_writer *w, bk_error *err)
     w->last_commit = wall_seconds();
     w->uncounted = 0;
     w->unflushed = 0.0;
+    haddr_t eoa = 0;
+    w->eoa_committed = H5Fget_eoa(w->file, &eoa) >= 0 ? (double)eoa : 0.0;
     w->committed_rows = w->rows;
     for (int k = 0; k < BK_N_TABLES; ++k)
         w->tables[k].committed = w->tables[k].written;
@@ -707,6 +711,21 @@ static void mark_incomplete(const char *part, const char *reason)
         H5Dclose(hold);
 }
 
+/* Every dataset back to its length at the last commit (shrinking only writes metadata). */
+static void cut_to_commit(bk_h5_writer *w)
+{
+    for (int i = 0; i < BK_N_SERIES; ++i) {
+        hsize_t dims[2] = {w->committed_rows, (hsize_t)w->s[i].cols};
+        if (w->s[i].dset >= 0)
+            H5Dset_extent(w->s[i].dset, dims);
+    }
+    for (int k = 0; k < BK_N_TABLES; ++k) {
+        hsize_t dims[1] = {w->tables[k].committed};
+        if (w->tables[k].dset >= 0)
+            H5Dset_extent(w->tables[k].dset, dims);
+    }
+}
+
 int bk_h5_writer_finish(bk_h5_writer *writer, const bk_run_stats *stats, bk_error *err)
 {
     bk_h5_writer *w = writer;
@@ -728,6 +747,15 @@ int bk_h5_writer_finish(bk_h5_writer *writer, const bk_run_stats *stats, bk_erro
             H5Fflush(w->file, H5F_SCOPE_LOCAL) < 0)
             rc = H5_FAIL(err, "%s: cannot write the complete flag", w->part);
     }
+    if (rc != BK_OK && w->out_of_room) {
+        /* Refused room for its last rows: left as abandon leaves it, at its last commit,
+         * incomplete, with the reason. */
+        cut_to_commit(w);
+        if (stats)
+            bk_h5_write_stats(w->file, stats);
+        bk_h5_write_double_attr(w->file, "t_reached", w->t_written);
+        bk_h5_write_fixed_string_attr(w->file, "error", err ? err->message : "no room for the last rows");
+    }
     if (bk_h5_writer_close(w) < 0 && rc == BK_OK)
         rc = H5_FAIL(err, "%s: cannot close", w->part);
     /* Something may have been put at the final name while the run went on. */
@@ -739,21 +767,6 @@ int bk_h5_writer_finish(bk_h5_writer *writer, const bk_run_stats *stats, bk_erro
         mark_incomplete(w->part, err ? err->message : "finishing the output failed");
     bk_h5_writer_free(w);
     return rc;
-}
-
-/* Every dataset back to its length at the last commit (shrinking only writes metadata). */
-static void cut_to_commit(bk_h5_writer *w)
-{
-    for (int i = 0; i < BK_N_SERIES; ++i) {
-        hsize_t dims[2] = {w->committed_rows, (hsize_t)w->s[i].cols};
-        if (w->s[i].dset >= 0)
-            H5Dset_extent(w->s[i].dset, dims);
-    }
-    for (int k = 0; k < BK_N_TABLES; ++k) {
-        hsize_t dims[1] = {w->tables[k].committed};
-        if (w->tables[k].dset >= 0)
-            H5Dset_extent(w->tables[k].dset, dims);
-    }
 }
 
 void bk_h5_writer_abandon(bk_h5_writer *writer, const char *reason, const bk_run_stats *stats)
