@@ -15,6 +15,7 @@ out=$1; title=$2; shift 2
 panels=""; k=0
 for spec in "$@"; do
     IFS=: read -r file label color <<<"$spec"
+    plot_require_sample_rows "$file" "apparent COF"
     "$bksim" export "$file" --datasets time,cof --block "$PLOT_BLOCK" > "$tmp/$k.dat"
     last=$(( $# - 1 ))
     if [ $k -eq $last ]; then xfmt="set format x '%g'; set xlabel 'time (s)'"; else xfmt="set format x ''; unset xlabel"; fi

@@ -15,14 +15,7 @@ out=$1; title=$2; shift 2
 pos_plot=""; vel_plot=""; k=0
 for spec in "$@"; do
     IFS=: read -r file label color <<<"$spec"
-    # A line through rows at transitions only would draw slips that never happened.
-    if [ "$(bk_sample_rows "$file")" -le 2 ]; then
-        bk_fail 1 "$file has no sample rows between t = 0 and its end (as with [output] interval = 0): block" \
-                "$PLOT_BLOCK's x(t) and v(t) between its transitions are not in it, and a line through" \
-                "the rows it has would draw slips that did not happen; run it with [output] interval > 0" \
-                "(bksim check says what the rows weigh), or list the transitions with" \
-                "bksim export $file --transitions"
-    fi
+    plot_require_sample_rows "$file" "x(t) and v(t)"
     # Column 5: driver velocity by finite differences over rows at least 1 us apart.
     "$bksim" export "$file" --datasets time,driver,x,v --block "$PLOT_BLOCK" |
         awk '/^#/ {next} { if (n++ && $1 - t > 1e-6) u = ($2 - d) / ($1 - t)

@@ -126,3 +126,15 @@ plot_file_shape() {
     read -r rows cols <<<"${shape:-1 $n_blocks}"
     [ "$((rows * cols))" -eq "$n_blocks" ] || bk_fail 1 "$1: a $rows x $cols lattice of $n_blocks blocks"
 }
+
+# plot_require_sample_rows FILE WHAT: refuse (exit 1) a run without sample rows between t = 0
+# and its end (as [output] interval = 0 writes): nothing of block PLOT_BLOCK's WHAT between
+# its transitions is in it, and a line through the rows it has (t = 0, the end, transition
+# instants) would draw slips that did not happen.
+plot_require_sample_rows() {
+    [ "$(bk_sample_rows "$1")" -le 2 ] || return 0
+    bk_fail 1 "$1 has no sample rows between t = 0 and its end (as with [output] interval = 0): nothing" \
+            "of block $PLOT_BLOCK's $2 between its transitions is in it, and a line through the rows it has" \
+            "would draw slips that did not happen; run it with [output] interval > 0 (bksim check says" \
+            "what the rows weigh), or list the transitions with bksim export $1 --transitions"
+}

@@ -77,7 +77,11 @@ static void test_summary_script(void **state)
     expect_command(cmd, 0, "peak slip rate n/a (no sample rows between t = 0 and the end)");
     snprintf(cmd, sizeof cmd, "BKSIM=./bksim scripts/plot_kinematics.sh %s/k.png t %s:run:blue", tmpdir, no_rows);
     expect_command(cmd, 1, "has no sample rows between t = 0 and its end (as with [output] interval = 0)");
+    snprintf(cmd, sizeof cmd, "BKSIM=./bksim scripts/plot_cof.sh %s/c.png t %s:run:blue", tmpdir, no_rows);
+    expect_command(cmd, 1, "nothing of block 0's apparent COF between its transitions is in it");
     snprintf(cmd, sizeof cmd, "%s/k.png", tmpdir);
+    assert_false(path_exists(cmd));
+    snprintf(cmd, sizeof cmd, "%s/c.png", tmpdir);
     assert_false(path_exists(cmd));
 }
 
