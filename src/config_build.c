@@ -16,16 +16,6 @@
 #include "config_loader.h"
 #include "layout.h"
 
-static void report_missing(loader *ld, const char *section, const bk_param *param, const key_def *def)
-{
-    if (RANK_MISSING >= ld->error_rank)
-        return; /* an earlier error stands: skip formatting, once per block of a long chain */
-    char allowed[1536];
-    bk_config_format_allowed(def, param, allowed, sizeof allowed);
-    bk_config_report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [%s] %s: required key missing (allowed: %s)", ld->name,
-                     section, param->key, allowed);
-}
-
 /* Value of a key in [section] (checked), or the definition's default. */
 static double value_of(loader *ld, const char *section, const char *key)
 {
@@ -40,7 +30,7 @@ static double value_of(loader *ld, const char *section, const char *key)
     if (def->type == BK_KEY_FIELDS)
         return (double)BK_FIELD_ALL;
     if (def->param.flags & BK_PARAM_REQUIRED)
-        report_missing(ld, section, &def->param, def);
+        bk_config_report_missing(ld, section, &def->param, def);
     return def->param.default_value;
 }
 
@@ -111,7 +101,7 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
     entry *base_law = bk_config_lookup(ld, "friction", "law");
     entry *law_entry = own_law ? own_law : base_law;
     if (!law_entry) {
-        report_missing(ld, "friction", &bk_config_find_key("friction", "law")->param,
+        bk_config_report_missing(ld, "friction", &bk_config_find_key("friction", "law")->param,
                        bk_config_find_key("friction", "law"));
         return;
     }
@@ -133,7 +123,7 @@ static void build_friction(loader *ld, bk_block *b, size_t i, double driver_spee
             b->friction_params[p] = e->distribution ? bk_config_draw(ld, e, i, param) : e->number;
             bk_config_record_parameter(ld, "friction", param->key, param->unit, i, b->friction_params[p]);
         } else if (param->flags & BK_PARAM_REQUIRED) {
-            report_missing(ld, param_section, param, NULL);
+            bk_config_report_missing(ld, param_section, param, NULL);
             b->friction_params[p] = NAN;
         } else {
             b->friction_params[p] = param->default_value;
@@ -248,84 +238,6 @@ static void check_initial_energy(loader *ld, const bk_model *m)
     free(x);
 }
 
-/* The driver: a constant velocity, or a history of velocities and durations (in keys, or a
- * table: velocities_file).  Returns the
- * history's length (s), or NAN for a constant velocity (or an error, reported). */
-static double build_driver(loader *ld, bk_model *m)
-{
-    m->driver.start_position = value_of(ld, "driver", "start_position");
-    entry *velocity = bk_config_lookup(ld, "driver", "velocity");
-    entry *velocities = bk_config_lookup(ld, "driver", "velocities");
-    entry *durations = bk_config_lookup(ld, "driver", "durations");
-    entry *file = bk_config_lookup(ld, "driver", "velocities_file");
-    if (file) {
-        entry *other = velocity ? velocity : velocities ? velocities : durations;
-        if (other) {
-            bk_config_report_entry(ld, other, "give velocities_file (a history from a table) or %s, not both "
-                                   "(velocities_file is %s)", other->key, file->value);
-            return NAN;
-        }
-        entry *t_end = bk_config_lookup(ld, "run", "t_end");
-        double *v = NULL, *d = NULL;
-        size_t n = 0;
-        if (bk_config_read_history(ld, file, t_end ? t_end->number : NAN, &v, &d, &n) != 0)
-            return NAN;
-        double total = 0.0;
-        for (size_t k = 0; k < n; ++k)
-            total += d[k];
-        int rc = isfinite(total) ? bk_driver_set_history(&m->driver, v, d, n) : 0;
-        free(v);
-        free(d);
-        if (!isfinite(total)) {
-            bk_config_report_entry(ld, file, "the history is longer than any finite time (allowed: a finite total)");
-            return NAN;
-        }
-        if (rc != 0) {
-            bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
-            return NAN;
-        }
-        return total;
-    }
-    if (velocity && velocities) {
-        bk_config_report_entry(ld, velocities, "give velocity (constant) or velocities (a history), not both "
-                               "(velocity is set at %s)", velocity->value);
-        return NAN;
-    }
-    if (!velocities) {
-        if (durations)
-            bk_config_report_entry(ld, durations, "applies with [driver] velocities, which is not given");
-        else if (!velocity)
-            report_missing(ld, "driver", &bk_config_find_key("driver", "velocity")->param,
-                           bk_config_find_key("driver", "velocity"));
-        m->driver.velocity = velocity ? velocity->number : NAN;
-        return NAN;
-    }
-    if (!durations) {
-        bk_config_report_entry(ld, velocities, "needs [driver] durations, one per velocity");
-        return NAN;
-    }
-    size_t n = (size_t)velocities->number;
-    if ((size_t)durations->number != n) {
-        bk_config_report_entry(ld, durations, "has %zu values, velocities has %zu (allowed: one duration per "
-                               "velocity)", (size_t)durations->number, n);
-        return NAN;
-    }
-    double total = 0.0;
-    for (size_t k = 0; k < n; ++k) {
-        total += durations->list[k];
-        if (!isfinite(total)) {
-            bk_config_report_entry(ld, durations, "segment %zu makes the history longer than any finite time "
-                                   "(allowed: a finite total duration)", k + 1);
-            return NAN;
-        }
-    }
-    if (bk_driver_set_history(&m->driver, velocities->list, durations->list, n) != 0) {
-        bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
-        return NAN;
-    }
-    return total;
-}
-
 /* The shape: n_blocks, rows and cols, any two of them implying the third (one alone: n_blocks,
  * a chain).  Returns 0 after an error, reported. */
 static size_t build_shape(loader *ld, size_t *rows, size_t *cols)
@@ -335,7 +247,7 @@ static size_t build_shape(loader *ld, size_t *rows, size_t *cols)
     entry *c_entry = bk_config_lookup(ld, "model", "cols");
     if (!n_entry && !(r_entry && c_entry)) {
         const key_def *def = bk_config_find_key("model", "n_blocks");
-        report_missing(ld, "model", &def->param, def);
+        bk_config_report_missing(ld, "model", &def->param, def);
         return 0;
     }
     size_t n = n_entry ? (size_t)n_entry->number : 0;
@@ -409,7 +321,8 @@ static void build_chain(loader *ld, bk_config *c)
     m->coupling_damping = value_of(ld, "model", "coupling_damping");
     m->gravity = value_of(ld, "model", "gravity");
     m->spring = (bk_spring)(int)value_of(ld, "driver", "spring");
-    double history = build_driver(ld, m);
+    m->driver.start_position = value_of(ld, "driver", "start_position");
+    double history = bk_config_build_driver(ld, m);
 
     /* The block keys' definitions, looked up once rather than per block. */
     enum { MASS, DRIVER_STIFFNESS, NORMAL_FORCE, X_INIT, X_INIT_RANDOM, V_INIT, DAMPING, APPLIED_FORCE, N_BLOCK_KEYS };
@@ -432,7 +345,7 @@ static void build_chain(loader *ld, bk_config *c)
         for (size_t r = MASS; r <= DRIVER_STIFFNESS; ++r) {
             double value = block_value(ld, i, def[r], &given);
             if (!given)
-                report_missing(ld, "block", &def[r]->param, def[r]);
+                bk_config_report_missing(ld, "block", &def[r]->param, def[r]);
             if (r == MASS)
                 b->mass = value;
             else
@@ -483,7 +396,7 @@ static void build_prescribed(loader *ld, bk_config *c)
     entry *durations = bk_config_lookup(ld, "prescribed", "durations");
     entry *distances = bk_config_lookup(ld, "prescribed", "distances");
     if (!rates) {
-        report_missing(ld, "prescribed", &bk_config_find_key("prescribed", "slip_rates")->param,
+        bk_config_report_missing(ld, "prescribed", &bk_config_find_key("prescribed", "slip_rates")->param,
                        bk_config_find_key("prescribed", "slip_rates"));
         return;
     }

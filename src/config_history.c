@@ -1,6 +1,6 @@
-/* [driver] velocities_file: a driver history of any length, read from a table.  A protocol of
- * hundreds of segments is written by a script or taken from an experiment's log, not typed
- * into one key.
+/* The driver: a constant velocity, or a history of segments given by [driver] velocities and
+ * durations, or by velocities_file, a table of any length: a protocol of hundreds of segments
+ * is written by a script or taken from an experiment's log, not typed into one key.
  *
  * The table: '#' starts a comment, blank lines are skipped, columns are separated by blanks,
  * tabs or one comma.  Its first line names the two columns, `velocity` and either `duration`
@@ -138,8 +138,7 @@ static int read_table(loader *ld, entry *e, const char *path, FILE *f, table *t,
     return rc;
 }
 
-int bk_config_read_history(loader *ld, entry *e, double t_end, double **velocities, double **durations,
-                           size_t *n)
+static int read_history(loader *ld, entry *e, double t_end, double **velocities, double **durations, size_t *n)
 {
     *velocities = *durations = NULL;
     *n = 0;
@@ -192,4 +191,77 @@ int bk_config_read_history(loader *ld, entry *e, double t_end, double **velociti
     *durations = other;
     *n = t.n;
     return 0;
+}
+
+/* Give the driver n segments; their total length (s), or NAN reported when it is not finite
+ * (at entry at) or memory runs out. */
+static double set_history(loader *ld, bk_model *m, const entry *at, const double *v, const double *d, size_t n)
+{
+    double total = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+        total += d[k];
+        if (!isfinite(total)) {
+            bk_config_report_entry(ld, at, "segment %zu makes the history longer than any finite time "
+                                   "(allowed: a finite total duration)", k + 1);
+            return NAN;
+        }
+    }
+    if (bk_driver_set_history(&m->driver, v, d, n) != 0) {
+        bk_config_report(ld, 0, BK_ERR_NOMEM, "%s: out of memory", ld->name);
+        return NAN;
+    }
+    return total;
+}
+
+/* The driver: a constant velocity, or a history of velocities and durations (in keys, or a
+ * table: velocities_file).  Returns the
+ * history's length (s), or NAN for a constant velocity (or an error, reported). */
+double bk_config_build_driver(loader *ld, bk_model *m)
+{
+    entry *velocity = bk_config_lookup(ld, "driver", "velocity");
+    entry *velocities = bk_config_lookup(ld, "driver", "velocities");
+    entry *durations = bk_config_lookup(ld, "driver", "durations");
+    entry *file = bk_config_lookup(ld, "driver", "velocities_file");
+    if (file) {
+        entry *other = velocity ? velocity : velocities ? velocities : durations;
+        if (other) {
+            bk_config_report_entry(ld, other, "give velocities_file (a history from a table) or %s, not both "
+                                   "(velocities_file is %s)", other->key, file->value);
+            return NAN;
+        }
+        entry *t_end = bk_config_lookup(ld, "run", "t_end");
+        double *v = NULL, *d = NULL;
+        size_t n = 0;
+        if (read_history(ld, file, t_end ? t_end->number : NAN, &v, &d, &n) != 0)
+            return NAN;
+        double total = set_history(ld, m, file, v, d, n);
+        free(v);
+        free(d);
+        return total;
+    }
+    if (velocity && velocities) {
+        bk_config_report_entry(ld, velocities, "give velocity (constant) or velocities (a history), not both "
+                               "(velocity is set at %s)", velocity->value);
+        return NAN;
+    }
+    if (!velocities) {
+        if (durations)
+            bk_config_report_entry(ld, durations, "applies with [driver] velocities, which is not given");
+        else if (!velocity)
+            bk_config_report_missing(ld, "driver", &bk_config_find_key("driver", "velocity")->param,
+                           bk_config_find_key("driver", "velocity"));
+        m->driver.velocity = velocity ? velocity->number : NAN;
+        return NAN;
+    }
+    if (!durations) {
+        bk_config_report_entry(ld, velocities, "needs [driver] durations, one per velocity");
+        return NAN;
+    }
+    size_t n = (size_t)velocities->number;
+    if ((size_t)durations->number != n) {
+        bk_config_report_entry(ld, durations, "has %zu values, velocities has %zu (allowed: one duration per "
+                               "velocity)", (size_t)durations->number, n);
+        return NAN;
+    }
+    return set_history(ld, m, durations, velocities->list, durations->list, n);
 }

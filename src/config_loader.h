@@ -1,7 +1,7 @@
 /* Private to the config loader, shared by its files: config_keys.c (the key table and the
  * reference), config_report.c (failures with their location), config_parse.c (text to
- * checked entries), config_random.c (values drawn per block), config_history.c (a driver
- * history from a file), config_tables.c (the files they read), config_build.c (entries to a
+ * checked entries), config_random.c (values drawn per block), config_history.c (the
+ * driver, its history from keys or a table), config_tables.c (the files they read), config_build.c (entries to a
  * bk_config, with the cross-key checks), config_warnings.c (plausibility warnings) and
  * config.c (the public entry points).  Not installed: the public API is
  * include/bksim/config.h. */
@@ -119,6 +119,8 @@ void bk_config_report(loader *ld, long rank, int status, const char *fmt, ...)
 /* The same for entry e: "file:line: [section] key: " and the message, at the entry's rank. */
 void bk_config_report_entry(loader *ld, const entry *e, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+/* "[section] key: required key missing", with what is allowed, at RANK_MISSING. */
+void bk_config_report_missing(loader *ld, const char *section, const bk_param *param, const key_def *def);
 /* "file:12" or "--set block.mass=0". */
 void bk_config_location(const loader *ld, const entry *e, char *buf, size_t len);
 
@@ -164,12 +166,13 @@ void bk_config_path_near(const loader *ld, const char *path, char *buf, size_t l
  * max_bytes (a device or a FIFO could be read for ever); NULL, reported, otherwise. */
 FILE *bk_config_open_table(loader *ld, const entry *e, const char *path, long max_bytes, const char *what);
 
-/* --- a driver history from a file (config_history.c) ---------------------------------- */
+/* --- the driver (config_history.c) ----------------------------------------------------- */
 
-/* [driver] velocities_file e: the segments' velocities and durations (malloc'ed, *n of them;
- * with a t column the last lasts until t_end).  0, or -1 reported with the table's file:line. */
-int bk_config_read_history(loader *ld, entry *e, double t_end, double **velocities, double **durations,
-                           size_t *n);
+/* The driver of [driver]: a constant velocity, or a history of velocities and durations (in
+ * keys, or a table: velocities_file, errors with its file:line; with a t column the last
+ * segment lasts until [run] t_end).  Returns the history's length (s), or NAN for a constant
+ * velocity (or an error, reported). */
+double bk_config_build_driver(loader *ld, bk_model *m);
 
 /* --- building (config_build.c) ---------------------------------------------------------- */
 

@@ -42,3 +42,13 @@ void bk_config_report_entry(loader *ld, const entry *e, const char *fmt, ...)
     va_end(ap);
     bk_config_report(ld, e->rank, BK_ERR_CONFIG, "%s: [%s] %s: %s", where, e->section, e->key, what);
 }
+
+void bk_config_report_missing(loader *ld, const char *section, const bk_param *param, const key_def *def)
+{
+    if (RANK_MISSING >= ld->error_rank)
+        return; /* an earlier error stands: skip formatting, once per block of a long chain */
+    char allowed[1536];
+    bk_config_format_allowed(def, param, allowed, sizeof allowed);
+    bk_config_report(ld, RANK_MISSING, BK_ERR_CONFIG, "%s: [%s] %s: required key missing (allowed: %s)", ld->name,
+                     section, param->key, allowed);
+}
