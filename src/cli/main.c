@@ -629,11 +629,13 @@ static int cmd_run(int argc, char **argv)
         fprintf(stderr, "%s\n", err.message);
         struct stat st;
         char *part = bk_output_part_path(path);
-        if (part && stat(part, &st) == 0 && rc == BK_ERR_INVALID) /* its name was taken meanwhile */
-            fprintf(stderr, "bksim: the finished run is kept in %s: move %s away, then `bksim run --restart %s` "
-                            "publishes it from its end\n", part, path, part);
-        else if (part && stat(part, &st) == 0)
-            say_how_to_go_on(config, path, rc);
+        if (part && stat(part, &st) == 0) {
+            if (rc == BK_ERR_INVALID) /* its name was taken meanwhile */
+                fprintf(stderr, "bksim: the finished run is kept in %s: move %s away, then `bksim run --restart %s` "
+                                "publishes it from its end\n", part, path, part);
+            else
+                say_how_to_go_on(config, path, rc);
+        }
         free(part);
         status = EXIT_RUN_FAILED;
     } else if (!args.quiet) {

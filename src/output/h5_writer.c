@@ -185,9 +185,10 @@ static int create_layout(bk_h5_writer *w, const bk_config *config, bk_error *err
         return H5_FAIL(err, "%s: cannot write root attributes", w->part);
 
     w->max_bytes = config->output.max_bytes > 0.0 ? config->output.max_bytes : INFINITY;
-    /* Sample rows, and the first and last; event rows cannot be foreseen. */
-    double interval = config->output.interval;
-    bk_h5_writer_size(w, model, interval > 0.0 ? floor(config->t_end / interval) + 2.0 : 2.0);
+    /* The sample rows bksim check announces; event rows cannot be foreseen. */
+    double rows = 0.0, row_bytes = 0.0, per_second = 0.0, transition_bytes = 0.0;
+    bk_config_output_estimate(config, &rows, &row_bytes, &per_second, &transition_bytes);
+    bk_h5_writer_size(w, model, rows);
     for (int i = 0; i < BK_N_SERIES; ++i) {
         const bk_series_def *def = &bk_series[i];
         bk_h5_series *s = &w->s[i];
